@@ -1,0 +1,40 @@
+# vibroblock: `make run` (set-up + main job) and `make test` (set-up + tests) on a fresh machine.
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+# Compiled numba kernels are cached here, so tests, sweeps and FMU instances reuse them.
+export NUMBA_CACHE_DIR := $(CURDIR)/.cache/numba
+export MPLBACKEND := Agg
+
+INSTALLED := $(VENV)/.installed
+FMUS := build/fmus/BlockA.fmu build/fmus/BlockB.fmu build/fmus/BlockC.fmu
+FMU_SOURCES := $(shell find fmu_src -name '*.py') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c
+
+.PHONY: setup fmus run test benchmark clean
+
+setup: $(INSTALLED)
+
+$(INSTALLED): requirements.txt pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -r requirements.txt
+	$(PY) -m pip install --quiet --no-deps -e .
+	touch $@
+
+fmus: $(FMUS)
+
+$(FMUS) &: $(INSTALLED) $(FMU_SOURCES)
+	$(PY) build/build_fmus.py
+
+run: fmus
+	$(PY) examples/fig1b_stick_slip_vs_sliding.py
+
+# pytest exits non-zero when no test ran (exit code 5), so an empty run fails here too.
+test: fmus
+	$(PY) -m pytest -q
+
+benchmark: fmus
+	$(PY) -m harness.benchmarks.core_and_fmu
+
+clean:
+	rm -rf build/fmus build/work .cache out

@@ -1,0 +1,264 @@
+"""A block on a vibrating plate: the one object the FMUs and the harness drive.
+
+``Block`` owns the state arrays, checks every value it is given, sets the initial
+state, advances the compiled integrators to any time and reports observables.  It
+knows nothing of FMI; the FMU classes are thin facades over it.
+"""
+from __future__ import annotations
+
+import cmath
+import math
+
+import numpy as np
+
+from . import layout as L
+from .models import MODELS, load, profile
+from .parameters import INITIAL_STATES, parameters_for
+from .stepping import INTEGRATORS, RK4, advance, observe
+
+# Largest dt^2 k/m + 2 dt gamma/m an integrator accepts for a spring-dashpot pair
+# (symplectic Euler is stable below 4; RK4 on the imaginary axis below 8, on the real
+# axis below ~5.6): margins that keep the ringing of the contact resolved.
+STABILITY_LIMIT = {"symplectic_euler": 1.0, "rk4": 4.0}
+
+OUTPUTS = ("x", "z", "vx", "vz", "friction_force", "normal_force", "contact", "slip_count", "phi_integral")
+
+
+class ModelError(ValueError):
+    """A value or request the model cannot accept; the message says which and why."""
+
+
+class Block:
+    """One block on a vibrating plate.
+
+    Parameters are the paper's symbols (see ``vibroblock.parameters``).  Typical use::
+
+        block = Block("A", A=0.5, omega=0.8)
+        block.start()
+        block.advance_to(100.0)
+        block.outputs()["x"]
+    """
+
+    def __init__(self, model: str = "A", integrator: str = "symplectic_euler", initial_state: int = 0,
+                 **parameters: float):
+        if model not in MODELS:
+            raise ModelError(f"unknown model {model!r}; choose one of {sorted(MODELS)}")
+        self.model = model
+        self.kind = MODELS[model]
+        self._specs = {p.name: p for p in parameters_for(model)}
+        self.parameters = {name: spec.default for name, spec in self._specs.items()}
+        self.started = False
+        self.integrator = "symplectic_euler"
+        self.initial_state = 0
+        self.set_integrator(integrator)
+        self.set_initial_state(initial_state)
+        for name, value in parameters.items():
+            self.set_parameter(name, value)
+
+    # ------------------------------------------------------------------ settings
+    def set_parameter(self, name: str, value: float) -> None:
+        spec = self._specs.get(name)
+        if spec is None:
+            raise ModelError(f"model {self.model} has no parameter {name!r}; it has {sorted(self._specs)}")
+        problem = spec.problem(value)
+        if problem:
+            raise ModelError(problem)
+        if self.started and not spec.tunable:
+            raise ModelError(f"{name} is fixed once the run has started; only A and omega can change during a run")
+        self.parameters[name] = float(value)
+        if self.started:
+            self._retune_drive()
+
+    def set_integrator(self, integrator: str | int) -> None:
+        names = list(INTEGRATORS)
+        if isinstance(integrator, (int, np.integer)) and not isinstance(integrator, bool):
+            if not 0 <= integrator < len(names):
+                raise ModelError(f"integrator = {integrator} is not one of {dict(enumerate(names))}")
+            integrator = names[integrator]
+        if integrator not in INTEGRATORS:
+            raise ModelError(f"unknown integrator {integrator!r}; choose one of {names}")
+        self._require_not_started("integrator")
+        self.integrator = integrator
+
+    def set_initial_state(self, mode: int) -> None:
+        if mode not in INITIAL_STATES:
+            raise ModelError(f"initial_state = {mode!r} is not one of {INITIAL_STATES}")
+        self._require_not_started("initial_state")
+        self.initial_state = int(mode)
+
+    def _require_not_started(self, what: str) -> None:
+        if self.started:
+            raise ModelError(f"{what} is fixed once the run has started")
+
+    def check_stability(self) -> None:
+        """Refuse an internal step that the chosen explicit integrator cannot resolve."""
+        p, dt = self.parameters, self.parameters["dt"]
+        limit = STABILITY_LIMIT[self.integrator]
+        for what, k, gamma in (("normal contact", p["k_n"], p["gamma_n"]),
+                               ("tangential contact", p["k_t"], p["gamma_t"])):
+            k_m, c_m = k / p["m"], gamma / p["m"]
+            if dt * dt * k_m + 2.0 * dt * c_m > limit:
+                dt_max = (limit / (2.0 * c_m) if k_m == 0.0
+                          else (-c_m + math.sqrt(c_m * c_m + limit * k_m)) / k_m)
+                raise ModelError(
+                    f"dt = {dt:g} is too large for the {what} (k/m = {k_m:g}, gamma/m = {c_m:g}) with "
+                    f"{self.integrator}: dt^2 k/m + 2 dt gamma/m must stay <= {limit:g}; use dt <= {dt_max:.3g}")
+
+    # ------------------------------------------------------------------ running
+    def start(self, t0: float = 0.0) -> None:
+        """Check the settings together and set the initial state at time t0."""
+        if not math.isfinite(t0):
+            raise ModelError(f"start time {t0!r} is not finite")
+        self.check_stability()
+        p = self.parameters
+        self.prm = np.zeros(L.N_PRM)
+        for i, name in enumerate(L.PRM_NAMES):
+            self.prm[i] = p.get(name, 0.0)
+        self.drv = np.zeros(L.N_DRV)
+        self.drv[L.D_T0], self.drv[L.D_DT] = t0, p["dt"]
+        self.drv[L.D_AMP], self.drv[L.D_OMEGA] = p["A"], p["omega"]
+        self.drv[L.D_PHASE], self.drv[L.D_EXT_T] = p["omega"] * t0, t0
+        self.cnt = np.zeros(L.N_CNT, dtype=np.int64)
+        self.y = np.zeros(L.N_Y)
+        self.time = t0
+        self._set_initial_state()
+        self.started = True
+        self._observed = None
+
+    def _set_initial_state(self) -> None:
+        p, y = self.parameters, self.y
+        x = p["x_start"]
+        height, slope = profile(self.kind, x, self.prm)
+        cos_a, sin_a = 1.0 / math.sqrt(1.0 + slope * slope), slope / math.sqrt(1.0 + slope * slope)
+        phase = self.drv[L.D_PHASE]
+        plate_z = p["A"] * math.sin(phase) + height
+        plate_v = p["A"] * p["omega"] * math.cos(phase)
+        # The confining load's component into the plate sets the rest penetration.
+        load_x, load_z = load(self.kind, cos_a, sin_a, self.prm)
+        weight = max(0.0, -(-load_x * sin_a + load_z * cos_a))
+        y[L.Y_X], y[L.Y_VX] = x, p["vx_start"]
+        if self.initial_state == 0:
+            y[L.Y_Z] = plate_z - weight / (p["k_n"] * cos_a)
+            y[L.Y_VZ] = p["vz_start"]
+        elif self.initial_state == 1:
+            y[L.Y_Z], y[L.Y_VZ] = p["z_start"], p["vz_start"]
+        else:
+            offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+            y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
+
+    def _retune_drive(self) -> None:
+        """Take new A, omega from the current grid step on, keeping the phase continuous."""
+        n = self.cnt[L.C_STEP]
+        phase = self.drv[L.D_PHASE] + self.drv[L.D_OMEGA] * self.drv[L.D_DT] * (n - self.cnt[L.C_PHASE_STEP])
+        self.drv[L.D_PHASE], self.cnt[L.C_PHASE_STEP] = phase, n
+        self.drv[L.D_AMP], self.drv[L.D_OMEGA] = self.parameters["A"], self.parameters["omega"]
+        self._observed = None
+
+    def set_plate_input(self, z: float, v: float, a: float) -> None:
+        """External plate motion from the current time on: z + v tau + a tau^2 / 2."""
+        for name, value in (("plate_z", z), ("plate_v", v), ("plate_a", a)):
+            if not math.isfinite(value):
+                raise ModelError(f"input {name} = {value!r} is not finite; the previous input is kept")
+        self._require_started()
+        self.drv[L.D_EXT_Z], self.drv[L.D_EXT_V], self.drv[L.D_EXT_A] = z, v, a
+        self.drv[L.D_EXT_T] = self.time
+        self._observed = None
+
+    def advance_to(self, t_end: float) -> None:
+        """Advance to t_end > current time; on failure the state is left unchanged."""
+        self._require_started()
+        if not (math.isfinite(t_end) and t_end > self.time):
+            raise ModelError(f"cannot advance from t = {self.time!r} to t = {t_end!r}: "
+                             "the end time must be finite and later than the current time")
+        dt, t0 = self.drv[L.D_DT], self.drv[L.D_T0]
+        # Grid point at or just below t_end; the tolerance absorbs rounding of t_end.
+        target = math.floor((t_end - t0) / dt + 1e-9)
+        todo = target - int(self.cnt[L.C_STEP])
+        if todo > 0:
+            done = advance(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, todo)
+            if done < 0:
+                raise ModelError(
+                    f"the state became non-finite while integrating from t = {self.time:g} to t = {t_end:g} "
+                    f"(dt = {dt:g}, {self.integrator}); the state at t = {self.time:g} is kept. "
+                    "Reduce dt or check the parameters for extreme values.")
+        self.time = float(t_end)
+        self._observed = None
+
+    def _require_started(self) -> None:
+        if not self.started:
+            raise ModelError("the run has not started: call start() (FMI: exit initialization mode) first")
+
+    # ------------------------------------------------------------------ observing
+    def _observation(self):
+        if self._observed is None:
+            dt = self.drv[L.D_DT]
+            grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
+            h = min(max(self.time - grid_time, 0.0), dt)
+            self._observed = observe(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv,
+                                     self.prm, h)
+        return self._observed
+
+    def outputs(self) -> dict[str, float | int | bool]:
+        """Observables at the current time (the FMU's outputs)."""
+        x, z, vx, vz, shear, pen, u_n, phi, slips, _ = self._observation()
+        in_contact = pen > 0.0
+        p = self.parameters
+        return {
+            "x": x, "z": z, "vx": vx, "vz": vz,
+            "friction_force": -p["k_t"] * shear if in_contact else 0.0,
+            "normal_force": p["k_n"] * pen - p["gamma_n"] * u_n if in_contact else 0.0,
+            "contact": bool(in_contact),
+            "slip_count": int(slips),
+            "phi_integral": phi,
+        }
+
+    @property
+    def grid_step(self) -> int:
+        return int(self.cnt[L.C_STEP])
+
+    # ------------------------------------------------------------------ state
+    def get_state(self) -> dict:
+        """Everything needed to continue the run bit for bit, as plain (JSON-able) values."""
+        self._require_started()
+        return {
+            "model": self.model, "integrator": self.integrator, "initial_state": self.initial_state,
+            "parameters": dict(self.parameters), "time": self.time,
+            "y": self.y.tolist(), "cnt": self.cnt.tolist(), "drv": self.drv.tolist(), "prm": self.prm.tolist(),
+        }
+
+    def set_state(self, state: dict) -> None:
+        if state.get("model") != self.model:
+            raise ModelError(f"state of model {state.get('model')!r} cannot be set on a model {self.model} block")
+        try:
+            y = np.array(state["y"], dtype=float)
+            cnt = np.array(state["cnt"], dtype=np.int64)
+            drv = np.array(state["drv"], dtype=float)
+            prm = np.array(state["prm"], dtype=float)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"not a valid block state: {exc}") from None
+        if (y.shape, cnt.shape, drv.shape, prm.shape) != ((L.N_Y,), (L.N_CNT,), (L.N_DRV,), (L.N_PRM,)):
+            raise ModelError("not a valid block state: array sizes differ from this model's")
+        self.y, self.cnt, self.drv, self.prm = y, cnt, drv, prm
+        self.parameters = dict(state["parameters"])
+        self.integrator, self.initial_state = state["integrator"], state["initial_state"]
+        self.time = float(state["time"])
+        self.started = True
+        self._observed = None
+
+
+def steady_orbit(m, k_n, gamma_n, weight, amplitude, omega, phase):
+    """Offset and rate of the block relative to a plate moving as A sin(phase), on the
+    steady in-contact orbit of m y'' + gamma_n y' + k_n y = -weight - m Z_p''."""
+    response = m * amplitude * omega**2 / complex(k_n - m * omega**2, gamma_n * omega)
+    rotating = response * cmath.exp(1j * phase)
+    return -weight / k_n + rotating.imag, (1j * omega * rotating).imag
+
+
+def detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07):
+    """Smallest amplitude at which the steady in-contact orbit of model A reaches zero
+    penetration: A_c = (g / omega^2) |k_n - m omega^2 + i gamma_n omega| / k_n.
+
+    It tends to the paper's A = g / omega^2 for omega << sqrt(k_n / m)."""
+    omega = np.asarray(omega, dtype=float)
+    return g / omega**2 * np.abs(k_n - m * omega**2 + 1j * gamma_n * omega) / k_n
+

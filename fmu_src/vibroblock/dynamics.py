@@ -1,0 +1,85 @@
+"""Forces shared by all model variants, written once in global coordinates.
+
+Formulation (docs/physics.md gives the derivation).  The block is a point r = (x, z);
+the plate surface is Z_p(x, t) = plate(t) + height(x), moving vertically only.  At the
+block's abscissa the surface has unit tangent t = (cos a, sin a) and outward normal
+n = (-sin a, cos a), a = arctan(dZ_p/dx).  Newton's law m r'' = sum of forces with
+
+* drive spring      (-k_d (x - V_d t), 0)
+* confining load    the variant's ``load`` (gravity, or -P_l n)
+* normal contact    N n,   N = k_n delta - gamma_n u_n            (only while delta > 0)
+* tangential        (-k_t F - gamma_t u_t) t                     (k_t F only while delta > 0)
+
+where delta = (Z_p - z) cos a is the penetration measured along the normal (distance
+to the surface's tangent line), u_n = (r' - plate'(t) e_z) . n and
+u_t = (r' - plate'(t) e_z) . t are the block's velocity relative to the plate, and F is
+the Cundall-Strack shear displacement, dF/dt = u_t while in contact.  Projected on t
+and n these are the paper's Eqs. (3)-(6); with a flat plate (a = 0) they are Eqs. (1)-(2)
+exactly.  N may be negative while the dashpot pulls the separating block: the paper's
+Heaviside factors gate on penetration only, and we follow them literally.
+"""
+import math
+
+from numba import njit
+
+from .layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_MUS, P_VD
+from .models import load, profile
+
+
+@njit(inline="always")
+def contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
+    """Penetration, normal and tangential velocity relative to the plate, and the tangent."""
+    height, slope = profile(kind, x, prm)
+    if slope == 0.0:  # flat plate: skip the square root (model A's hot path)
+        cos_a, sin_a = 1.0, 0.0
+    else:
+        cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
+        sin_a = slope * cos_a
+    penetration = (plate_z + height - z) * cos_a
+    rel_vz = vz - plate_v
+    u_n = rel_vz * cos_a - vx * sin_a
+    u_t = vx * cos_a + rel_vz * sin_a
+    return penetration, u_n, u_t, cos_a, sin_a
+
+
+@njit(inline="always")
+def normal_force(penetration, u_n, prm):
+    if penetration > 0.0:
+        return prm[P_KN] * penetration - prm[P_GN] * u_n
+    return 0.0
+
+
+@njit(inline="always")
+def force(kind, x, t, penetration, u_n, u_t, cos_a, sin_a, shear, prm):
+    """Total force on the block (callers divide by m once per step, not per call)."""
+    normal = normal_force(penetration, u_n, prm)
+    tangential = -prm[P_GT] * u_t
+    if penetration > 0.0:
+        tangential -= prm[P_KT] * shear
+    load_x, load_z = load(kind, cos_a, sin_a, prm)
+    fx = -prm[P_KD] * (x - prm[P_VD] * t) - normal * sin_a + tangential * cos_a + load_x
+    fz = normal * cos_a + tangential * sin_a + load_z
+    return fx, fz
+
+
+@njit(inline="always")
+def friction_rule(shear, penetration, u_n, prm):
+    """The paper's reset rule: F = 0 once detached, or when |k_t F| >= mu_s N.
+
+    Returns the new shear displacement and whether a Coulomb reset of a loaded
+    spring happened (resets of an already relaxed spring are not counted).
+    """
+    if penetration <= 0.0:
+        return 0.0, False
+    if abs(prm[P_KT] * shear) >= prm[P_MUS] * normal_force(penetration, u_n, prm):
+        return 0.0, shear != 0.0
+    return shear, False
+
+
+@njit(inline="always")
+def plate_motion(amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau):
+    """Plate height and velocity: harmonic drive plus the external input, which is held
+    at constant acceleration over a communication step (tau = time since it was set)."""
+    z = amp * sin_phase + ext_z + tau * (ext_v + 0.5 * ext_a * tau)
+    v = amp * omega * cos_phase + ext_v + ext_a * tau
+    return z, v

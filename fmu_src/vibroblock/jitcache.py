@@ -1,0 +1,55 @@
+"""On-disk cache of the compiled kernels, addressed by the core's content.
+
+numba files its cache under a folder derived from the source file's directory.  An
+FMU is usually extracted to a fresh temporary folder, which would make every new
+extraction recompile the kernels (seconds per instance).  This locator files the
+kernels of this package under a digest of the package's sources instead: any copy of
+the same core shares one cache, and any change of any core file (kernels inline
+functions from several files) invalidates it.
+"""
+from __future__ import annotations
+
+import hashlib
+from functools import lru_cache
+from pathlib import Path
+
+from numba.core import caching, config
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+
+
+def core_digest(package_dir: Path = PACKAGE_DIR) -> str:
+    """Digest of the physics core's sources, to tell two copies apart."""
+    digest = hashlib.sha256()
+    for path in sorted(Path(package_dir).rglob("*.py")):
+        digest.update(path.relative_to(package_dir).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+@lru_cache(maxsize=None)
+def _package_digest(package_dir: Path) -> str:
+    return core_digest(package_dir)
+
+
+class CoreCacheLocator(caching.UserProvidedCacheLocator):
+    """numba cache locator for this package's kernels (see module doc)."""
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if not config.CACHE_DIR or not Path(py_file).resolve().is_relative_to(PACKAGE_DIR):
+            return None
+        return super().from_function(py_func, py_file)
+
+    @classmethod
+    def get_suitable_cache_subpath(cls, py_file):
+        relative = Path(py_file).resolve().parent.relative_to(PACKAGE_DIR).as_posix()
+        folder = hashlib.sha1(f"{_package_digest(PACKAGE_DIR)}/{relative}".encode()).hexdigest()
+        return f"vibroblock_{folder}"
+
+
+def install() -> None:
+    """Put the locator first in numba's list (idempotent)."""
+    locators = caching.CacheImpl._locator_classes
+    if not any(cls.__name__ == CoreCacheLocator.__name__ and cls.__module__ == __name__ for cls in locators):
+        locators.insert(0, CoreCacheLocator)

@@ -1,0 +1,14 @@
+"""Model A: flat plate, block confined by gravity (paper Eqs. 1-2)."""
+from numba import njit
+
+from ..layout import P_G, P_M
+
+
+@njit(inline="always")
+def profile(x, prm):
+    return 0.0, 0.0
+
+
+@njit(inline="always")
+def load(cos_a, sin_a, prm):
+    return 0.0, -prm[P_M] * prm[P_G]

@@ -1,0 +1,98 @@
+"""The model's parameters: names, paper defaults, units and admissible values.
+
+One table serves the FMU interface (variable names, start values, descriptions),
+the core's validation and the README's interface table, so the three cannot drift.
+
+Units follow the paper (Sec. II C): m = g = k_n = 1, lengths in delta_0 = m g / k_n,
+times in tau_0 = sqrt(m / k_n).  All parameters are Real.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+# What a value must satisfy; the message completes "must be ...".
+FINITE = "finite"
+POSITIVE = "positive"
+NON_NEGATIVE = "non-negative"
+
+_CHECKS = {
+    FINITE: (lambda v: True, "a finite number"),
+    POSITIVE: (lambda v: v > 0.0, "a finite number > 0"),
+    NON_NEGATIVE: (lambda v: v >= 0.0, "a finite number >= 0"),
+}
+
+
+@dataclass(frozen=True)
+class Parameter:
+    name: str
+    default: float
+    unit: str
+    description: str
+    constraint: str = FINITE
+    tunable: bool = False
+    models: str = "ABC"  # the variants that have this parameter
+
+    def problem(self, value) -> str | None:
+        """Why ``value`` is not admissible for this parameter, or None."""
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            return f"{self.name} = {value!r} is not a number"
+        ok, wanted = _CHECKS[self.constraint]
+        if not math.isfinite(v) or not ok(v):
+            return f"{self.name} = {v!r} is not admissible: it must be {wanted} ({self.description})"
+        return None
+
+
+L, T = "delta_0", "tau_0"
+PARAMETERS: tuple[Parameter, ...] = (
+    Parameter("m", 1.0, "m_0", "block mass", POSITIVE),
+    Parameter("g", 1.0, f"{L}/{T}^2", "gravitational acceleration (models A, B)", NON_NEGATIVE, models="AB"),
+    Parameter("k_n", 1.0, f"m_0/{T}^2", "normal contact stiffness", POSITIVE),
+    Parameter("k_t", 0.28, f"m_0/{T}^2", "tangential (Cundall-Strack) contact stiffness", NON_NEGATIVE),
+    Parameter("gamma_n", 0.07, f"m_0/{T}", "normal contact damping", NON_NEGATIVE),
+    Parameter("gamma_t", 2.5e-4, f"m_0/{T}", "tangential damping", NON_NEGATIVE),
+    Parameter("mu_s", 0.5, "1", "static friction coefficient (Coulomb bound mu_s N)", NON_NEGATIVE),
+    Parameter("k_d", 5e-4, f"m_0/{T}^2", "drive spring stiffness", NON_NEGATIVE),
+    Parameter("V_d", 2e-5, f"{L}/{T}", "drive velocity of the spring's far end", FINITE),
+    Parameter("A", 0.0, L, "amplitude of the internal plate drive A sin(omega t)", FINITE, tunable=True),
+    Parameter("omega", 0.0, f"1/{T}", "angular frequency of the internal plate drive", NON_NEGATIVE, tunable=True),
+    Parameter("A_x", 1e3, L, "corrugation amplitude: plate surface A_x sin(omega_x x)", NON_NEGATIVE, models="BC"),
+    Parameter("omega_x", 2e-2, f"1/{L}", "corrugation wave number", NON_NEGATIVE, models="BC"),
+    Parameter("P_l", 1.0, f"m_0 {L}/{T}^2", "confining force, normal to the plate surface", NON_NEGATIVE, models="C"),
+    Parameter("dt", 4e-4, T, "internal integration step", POSITIVE),
+    Parameter("x_start", 0.0, L, "initial horizontal position", FINITE),
+    Parameter("z_start", 0.0, L, "initial height (used when initial_state = 1)", FINITE),
+    Parameter("vx_start", 0.0, f"{L}/{T}", "initial horizontal velocity", FINITE),
+    Parameter("vz_start", 0.0, f"{L}/{T}", "initial vertical velocity (initial_state 0 and 1)", FINITE),
+)
+
+# Model B of the paper (Sec. III B) uses another drive; C keeps B's corrugation.
+MODEL_DEFAULTS: dict[str, dict[str, float]] = {
+    "A": {},
+    "B": {"V_d": 2e-4, "k_d": 5e-6},
+    "C": {"V_d": 2e-4, "k_d": 5e-6},
+}
+
+INITIAL_STATES = {
+    0: "equilibrium: at rest (vx_start, vz_start) at the rest penetration under the plate's initial position",
+    1: "given: x_start, z_start, vx_start, vz_start as set",
+    2: "steady_orbit: on the steady in-contact orbit of the harmonic drive (exact for model A)",
+}
+
+
+def parameters_for(model: str) -> tuple[Parameter, ...]:
+    """The parameters of one model variant, with that variant's defaults."""
+    overrides = MODEL_DEFAULTS[model]
+    out = []
+    for p in PARAMETERS:
+        if model in p.models:
+            if p.name in overrides:
+                p = Parameter(**{**p.__dict__, "default": overrides[p.name]})
+            out.append(p)
+    return tuple(out)
+
+
+def defaults(model: str) -> dict[str, float]:
+    return {p.name: p.default for p in parameters_for(model)}

@@ -1,0 +1,263 @@
+"""Fixed-step integrators over the shared dynamics, compiled with numba.
+
+Contract every integrator obeys (a new one must too):
+
+* it advances the arrays (y, cnt) in place by whole internal steps on the grid
+  t_n = t0 + n dt, n = cnt[C_STEP]; time is never accumulated;
+* the stored state always satisfies the friction rule (F = 0 out of contact, and
+  |k_t F| < mu_s N in contact): the rule is applied at the end of every step, at the
+  new state, and a Coulomb reset of a loaded spring increments cnt[C_SLIPS];
+* the plate drive is evaluated as a function of n alone, so advancing n1 + n2 steps in
+  two calls gives the same bits as n1 + n2 steps in one call;
+* it returns the number of steps taken, or -1 if the state stopped being finite, in
+  which case the arrays are left as they were on entry (the last good state).
+
+Integrators
+-----------
+``symplectic_euler`` (id 0) -- the paper's first-order scheme, as we read it: velocity
+first, then position with the new velocity (semi-implicit Euler); the shear
+displacement grows by dt times the new tangential velocity while the step started in
+contact.  For model A this makes F exactly the horizontal travel since the contact
+began.  First order, one force evaluation per step.
+
+``rk4`` (id 1) -- classical fourth-order Runge-Kutta on (x, z, vx, vz, F, phi) with the
+contact gate Theta(delta) evaluated inside each stage; the reset rule is applied after
+the step.  Fourth order between events, first order across a contact switch or reset.
+"""
+import math
+
+from numba import njit
+
+from .dynamics import contact, force, friction_rule, plate_motion
+from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z,
+                     D_OMEGA, D_PHASE, D_T0, P_M, P_VD, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_X, Y_Z)
+
+SYMPLECTIC_EULER, RK4 = 0, 1
+INTEGRATORS = {"symplectic_euler": SYMPLECTIC_EULER, "rk4": RK4}
+# Evaluations of the forces per internal step: the cost unit of a scheme.
+FORCE_EVALUATIONS = {"symplectic_euler": 1, "rk4": 4}
+
+# The drive's sine and cosine advance by a rotation each step (a sin/cos pair costs more
+# than a whole model-A step) and are recomputed exactly every RESYNC steps, counted from
+# the phase anchor, so rounding cannot build up and the values depend on n only.
+RESYNC = 256
+# How often (in steps) a long run checks that the state is still finite.
+FINITE_CHECK = 1 << 16
+
+
+@njit(inline="always")
+def drive_phase(drv, cnt, n):
+    return drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n - cnt[C_PHASE_STEP])
+
+
+@njit(inline="always")
+def drive_sin_cos(drv, cnt, n):
+    """sin and cos of the drive phase at step n, bit-identical to what a run reaching
+    step n through the rotation recurrence holds."""
+    since_anchor = n - cnt[C_PHASE_STEP]
+    base = n - since_anchor % RESYNC
+    phase = drive_phase(drv, cnt, base)
+    s, c = math.sin(phase), math.cos(phase)
+    rot_s, rot_c = math.sin(drv[D_OMEGA] * drv[D_DT]), math.cos(drv[D_OMEGA] * drv[D_DT])
+    for _ in range(n - base):
+        s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
+    return s, c
+
+
+@njit(inline="always")
+def kahan_add(total, compensation, value):
+    corrected = value - compensation
+    new_total = total + corrected
+    return new_total, (new_total - total) - corrected
+
+
+@njit(inline="always")
+def is_finite_state(x, z, vx, vz, shear):
+    return math.isfinite(x + z + vx + vz + shear)
+
+
+@njit(cache=True)
+def advance(kind, method, y, cnt, drv, prm, n_steps):
+    """Advance by n_steps internal steps with the chosen integrator (see module doc)."""
+    if method == RK4:
+        return _advance_rk4(kind, y, cnt, drv, prm, n_steps)
+    return _advance_euler(kind, y, cnt, drv, prm, n_steps)
+
+
+@njit(inline="always")
+def _plate_at_step(drv, s, c, t):
+    return plate_motion(drv[D_AMP], drv[D_OMEGA], s, c, drv[D_EXT_Z], drv[D_EXT_V], drv[D_EXT_A],
+                        t - drv[D_EXT_T])
+
+
+@njit(cache=True)
+def _advance_euler(kind, y, cnt, drv, prm, n_steps):
+    t0, dt, v_drive = drv[D_T0], drv[D_DT], prm[P_VD]
+    dt_m = dt / prm[P_M]
+    # A plate at rest (no drive, no input) needs no kinematics in the loop.
+    plate_moves = drv[D_AMP] != 0.0 or drv[D_EXT_V] != 0.0 or drv[D_EXT_A] != 0.0
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
+    rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
+    s, c = drive_sin_cos(drv, cnt, n)
+
+    t = t0 + n * dt
+    plate_z, plate_v = _plate_at_step(drv, s, c, t)
+    pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    done = 0
+    while done < n_steps:
+        fx, fz = force(kind, x, t, pen, u_n, u_t, cos_a, sin_a, shear, prm)
+        engaged = pen > 0.0
+        vx += dt_m * fx
+        vz += dt_m * fz
+        x += dt * vx
+        z += dt * vz
+        n += 1
+        done += 1
+        t = t0 + n * dt
+        if plate_moves:
+            if (n - anchor) % RESYNC == 0:
+                phase = drive_phase(drv, cnt, n)
+                s, c = math.sin(phase), math.cos(phase)
+            else:
+                s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
+            plate_z, plate_v = _plate_at_step(drv, s, c, t)
+        pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+        if engaged:
+            shear += dt * u_t
+        shear, reset = friction_rule(shear, pen, u_n, prm)
+        slips += reset
+        dv = vx - v_drive
+        phi, phi_c = kahan_add(phi, phi_c, dt * dv * dv)
+        if done % FINITE_CHECK == 0 and not is_finite_state(x, z, vx, vz, shear):
+            return -1
+    if not is_finite_state(x, z, vx, vz, shear):
+        return -1
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
+    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    return done
+
+
+@njit(inline="always")
+def _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v):
+    pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    fx, fz = force(kind, x, t, pen, u_n, u_t, cos_a, sin_a, shear, prm)
+    d_shear = u_t if pen > 0.0 else 0.0
+    dv = vx - prm[P_VD]
+    return fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv
+
+
+@njit(inline="always")
+def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, pz1, pv1):
+    """One classical RK4 step of length h; returns the new state and the phi increment."""
+    half = 0.5 * h
+    ax1, az1, df1, dp1 = _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0)
+    ax2, az2, df2, dp2 = _rk4_rhs(kind, prm, x + half * vx, z + half * vz, vx + half * ax1, vz + half * az1,
+                                  shear + half * df1, t + half, pz_half, pv_half)
+    vx2, vz2 = vx + half * ax1, vz + half * az1
+    ax3, az3, df3, dp3 = _rk4_rhs(kind, prm, x + half * vx2, z + half * vz2, vx + half * ax2, vz + half * az2,
+                                  shear + half * df2, t + half, pz_half, pv_half)
+    vx3, vz3 = vx + half * ax2, vz + half * az2
+    ax4, az4, df4, dp4 = _rk4_rhs(kind, prm, x + h * vx3, z + h * vz3, vx + h * ax3, vz + h * az3,
+                                  shear + h * df3, t + h, pz1, pv1)
+    vx4, vz4 = vx + h * ax3, vz + h * az3
+    sixth = h / 6.0
+    x_new = x + sixth * (vx + 2.0 * vx2 + 2.0 * vx3 + vx4)
+    z_new = z + sixth * (vz + 2.0 * vz2 + 2.0 * vz3 + vz4)
+    vx_new = vx + sixth * (ax1 + 2.0 * ax2 + 2.0 * ax3 + ax4)
+    vz_new = vz + sixth * (az1 + 2.0 * az2 + 2.0 * az3 + az4)
+    shear_new = shear + sixth * (df1 + 2.0 * df2 + 2.0 * df3 + df4)
+    d_phi = sixth * (dp1 + 2.0 * dp2 + 2.0 * dp3 + dp4)
+    return x_new, z_new, vx_new, vz_new, shear_new, d_phi
+
+
+@njit(cache=True)
+def _advance_rk4(kind, y, cnt, drv, prm, n_steps):
+    t0, dt = drv[D_T0], drv[D_DT]
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
+    rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
+    half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
+    s, c = drive_sin_cos(drv, cnt, n)
+    t = t0 + n * dt
+    pz0, pv0 = _plate_at_step(drv, s, c, t)
+    done = 0
+    while done < n_steps:
+        sh, ch = s * half_c + c * half_s, c * half_c - s * half_s
+        pz_half, pv_half = _plate_at_step(drv, sh, ch, t + 0.5 * dt)
+        n += 1
+        done += 1
+        if (n - anchor) % RESYNC == 0:
+            phase = drive_phase(drv, cnt, n)
+            s, c = math.sin(phase), math.cos(phase)
+        else:
+            s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
+        t_new = t0 + n * dt
+        pz1, pv1 = _plate_at_step(drv, s, c, t_new)
+        x, z, vx, vz, shear, d_phi = rk4_step(kind, prm, x, z, vx, vz, shear, t, t_new - t,
+                                              pz0, pv0, pz_half, pv_half, pz1, pv1)
+        pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        shear, reset = friction_rule(shear, pen, u_n, prm)
+        slips += reset
+        phi, phi_c = kahan_add(phi, phi_c, d_phi)
+        t, pz0, pv0 = t_new, pz1, pv1
+        if done % FINITE_CHECK == 0 and not is_finite_state(x, z, vx, vz, shear):
+            return -1
+    if not is_finite_state(x, z, vx, vz, shear):
+        return -1
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
+    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    return done
+
+
+@njit(inline="always")
+def plate_at_time(drv, cnt, prm, t):
+    """Plate height and velocity at an arbitrary time (off the grid): exact sin/cos."""
+    anchor_time = drv[D_T0] + cnt[C_PHASE_STEP] * drv[D_DT]
+    phase = drv[D_PHASE] + drv[D_OMEGA] * (t - anchor_time)
+    return plate_motion(drv[D_AMP], drv[D_OMEGA], math.sin(phase), math.cos(phase),
+                        drv[D_EXT_Z], drv[D_EXT_V], drv[D_EXT_A], t - drv[D_EXT_T])
+
+
+@njit(cache=True)
+def observe(kind, method, y, cnt, drv, prm, h):
+    """State at t_n + h, 0 <= h < dt, without touching the stored state.
+
+    A communication point between two grid points is reached by one scratch step of
+    length h from the grid state, so outputs are at the requested time while the
+    stored trajectory stays on the grid (and so independent of the communication
+    steps).  Returns (x, z, vx, vz, F, penetration, u_n, phi, slips, plate_z).
+    """
+    t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, slips = y[Y_PHI], cnt[C_SLIPS]
+    plate_z, plate_v = plate_at_time(drv, cnt, prm, t)
+    pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    if h > 0.0:
+        pz1, pv1 = plate_at_time(drv, cnt, prm, t + h)
+        if method == RK4:
+            pzh, pvh = plate_at_time(drv, cnt, prm, t + 0.5 * h)
+            x, z, vx, vz, shear, d_phi = rk4_step(kind, prm, x, z, vx, vz, shear, t, h,
+                                                  plate_z, plate_v, pzh, pvh, pz1, pv1)
+            pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        else:
+            fx, fz = force(kind, x, t, pen, u_n, u_t, cos_a, sin_a, shear, prm)
+            engaged = pen > 0.0
+            vx += h * fx / prm[P_M]
+            vz += h * fz / prm[P_M]
+            x += h * vx
+            z += h * vz
+            pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+            if engaged:
+                shear += h * u_t
+            dv = vx - prm[P_VD]
+            d_phi = h * dv * dv
+        shear, reset = friction_rule(shear, pen, u_n, prm)
+        slips += reset
+        phi += d_phi
+        plate_z = pz1
+    return x, z, vx, vz, shear, pen, u_n, phi, slips, plate_z
