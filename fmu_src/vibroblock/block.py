@@ -21,7 +21,8 @@ from .stepping import INTEGRATORS, RK4, advance, observe
 # axis below ~5.6): margins that keep the ringing of the contact resolved.
 STABILITY_LIMIT = {"symplectic_euler": 1.0, "rk4": 4.0}
 
-OUTPUTS = ("x", "z", "vx", "vz", "friction_force", "normal_force", "contact", "slip_count", "phi_integral")
+OUTPUTS = ("x", "z", "vx", "vz", "friction_force", "normal_force", "contact", "slip_count", "phi_integral",
+           "penetration", "surface_z")
 
 
 class ModelError(ValueError):
@@ -189,28 +190,34 @@ class Block:
             raise ModelError("the run has not started: call start() (FMI: exit initialization mode) first")
 
     # ------------------------------------------------------------------ observing
-    def _observation(self):
+    def outputs(self) -> dict[str, float | int | bool]:
+        """Observables at the current time (the FMU's outputs)."""
+        return dict(self._observables())
+
+    def output(self, name: str):
+        return self._observables()[name]
+
+    def _observables(self) -> dict:
         if self._observed is None:
+            self._require_started()
             dt = self.drv[L.D_DT]
             grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
             h = min(max(self.time - grid_time, 0.0), dt)
-            self._observed = observe(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv,
-                                     self.prm, h)
+            x, z, vx, vz, shear, pen, u_n, phi, slips, cos_a = observe(
+                self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, h)
+            in_contact = pen > 0.0
+            p = self.parameters
+            self._observed = {
+                "x": x, "z": z, "vx": vx, "vz": vz,
+                "friction_force": -p["k_t"] * shear if in_contact else 0.0,
+                "normal_force": p["k_n"] * pen - p["gamma_n"] * u_n if in_contact else 0.0,
+                "contact": bool(in_contact),
+                "slip_count": int(slips),
+                "phi_integral": phi,
+                "penetration": pen,
+                "surface_z": z + pen / cos_a,
+            }
         return self._observed
-
-    def outputs(self) -> dict[str, float | int | bool]:
-        """Observables at the current time (the FMU's outputs)."""
-        x, z, vx, vz, shear, pen, u_n, phi, slips, _ = self._observation()
-        in_contact = pen > 0.0
-        p = self.parameters
-        return {
-            "x": x, "z": z, "vx": vx, "vz": vz,
-            "friction_force": -p["k_t"] * shear if in_contact else 0.0,
-            "normal_force": p["k_n"] * pen - p["gamma_n"] * u_n if in_contact else 0.0,
-            "contact": bool(in_contact),
-            "slip_count": int(slips),
-            "phi_integral": phi,
-        }
 
     @property
     def grid_step(self) -> int:

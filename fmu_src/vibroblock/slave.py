@@ -46,6 +46,8 @@ REAL_OUTPUTS = {
     "friction_force": "tangential spring force -k_t F along the plate's tangent, 0 out of contact [m_0 delta_0/tau_0^2]",
     "normal_force": "normal contact force k_n delta - gamma_n u_n, 0 out of contact [m_0 delta_0/tau_0^2]",
     "phi_integral": "integral of (vx - V_d)^2 dt since the start [delta_0^2/tau_0]",
+    "penetration": "penetration delta = (Z_p - z) cos(alpha) along the surface normal; > 0 in contact [delta_0]",
+    "surface_z": "height of the plate surface Z_p(x, t) under the block [delta_0]",
 }
 INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
 INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
@@ -110,7 +112,7 @@ class BlockSlave(Fmi2Slave):
     def _output(self, name):
         if not self.block.started:
             return 0.0  # before initialization outputs are not yet calculated
-        return self.block.outputs()[name]
+        return self.block.output(name)
 
     # ------------------------------------------------------------------ guarding
     def _guard(self, action, *args) -> bool:

@@ -230,7 +230,7 @@ def observe(kind, method, y, cnt, drv, prm, h):
     A communication point between two grid points is reached by one scratch step of
     length h from the grid state, so outputs are at the requested time while the
     stored trajectory stays on the grid (and so independent of the communication
-    steps).  Returns (x, z, vx, vz, F, penetration, u_n, phi, slips, plate_z).
+    steps).  Returns (x, z, vx, vz, F, penetration, u_n, phi, slips, cos a).
     """
     t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
@@ -259,5 +259,4 @@ def observe(kind, method, y, cnt, drv, prm, h):
         shear, reset = friction_rule(shear, pen, u_n, prm)
         slips += reset
         phi += d_phi
-        plate_z = pz1
-    return x, z, vx, vz, shear, pen, u_n, phi, slips, plate_z
+    return x, z, vx, vz, shear, pen, u_n, phi, slips, cos_a

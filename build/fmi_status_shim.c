@@ -1,0 +1,392 @@
+/*
+ * fmi_status_shim.c - FMI 2.0 Co-Simulation front end for the Python-backed FMUs.
+ *
+ * The Python slaves never raise: on bad input they log a message with status
+ * fmi2Error (or fmi2Warning/fmi2Discard) and return normally, keeping their
+ * last good state.  The library that runs them reports such a call as fmi2OK,
+ * and it passes log messages on only while debug logging is on.
+ *
+ * This library is installed as binaries/linux64/<modelIdentifier>.so; the
+ * library that runs the Python slave sits next to it as
+ * <modelIdentifier>_pythonfmu.so ("inner library").  Every FMI call is
+ * forwarded to the inner library, and:
+ *   - the inner library's debug logging is always on, so every message passes
+ *     through here; warnings, errors and fatal errors always reach the host's
+ *     logger, fmi2OK and fmi2Discard messages only while the host has debug
+ *     logging on (restricted to the categories it asked for, if any);
+ *   - a call returns the worse of the inner library's status and the worst
+ *     status logged during the call.  A logged fmi2Fatal counts as fmi2Error:
+ *     the slave returned normally, so the instance is still usable.  A status
+ *     returned by the inner library (fmi2Fatal from an exception included)
+ *     passes through unchanged.
+ *
+ * A call on one instance touches only that instance's record, so instances
+ * may be used from different threads (each by one thread at a time, as FMI
+ * requires).
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- FMI 2.0 types (platform "default") -------------------------------- */
+
+typedef void*              fmi2Component;
+typedef void*              fmi2ComponentEnvironment;
+typedef void*              fmi2FMUstate;
+typedef unsigned int       fmi2ValueReference;
+typedef double             fmi2Real;
+typedef int                fmi2Integer;
+typedef int                fmi2Boolean;
+typedef char               fmi2Char;
+typedef const fmi2Char*    fmi2String;
+typedef char               fmi2Byte;
+
+#define fmi2True  1
+#define fmi2False 0
+
+typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
+typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
+typedef enum { fmi2DoStepStatus, fmi2PendingStatus, fmi2LastSuccessfulTime, fmi2Terminated } fmi2StatusKind;
+
+typedef void  (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String instanceName, fmi2Status,
+                                    fmi2String category, fmi2String message, ...);
+typedef void* (*fmi2CallbackAllocateMemory)(size_t, size_t);
+typedef void  (*fmi2CallbackFreeMemory)(void*);
+typedef void  (*fmi2StepFinished)(fmi2ComponentEnvironment, fmi2Status);
+
+typedef struct {
+    fmi2CallbackLogger         logger;
+    fmi2CallbackAllocateMemory allocateMemory;
+    fmi2CallbackFreeMemory     freeMemory;
+    fmi2StepFinished           stepFinished;
+    fmi2ComponentEnvironment   componentEnvironment;
+} fmi2CallbackFunctions;
+
+/* ---- the exported API --------------------------------------------------- */
+
+#define EXPORT __attribute__((visibility("default")))
+
+EXPORT const char* fmi2GetTypesPlatform(void);
+EXPORT const char* fmi2GetVersion(void);
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component, fmi2Boolean, size_t, const fmi2String[]);
+EXPORT fmi2Component fmi2Instantiate(fmi2String, fmi2Type, fmi2String, fmi2String,
+                                     const fmi2CallbackFunctions*, fmi2Boolean, fmi2Boolean);
+EXPORT void fmi2FreeInstance(fmi2Component);
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component, fmi2Boolean, fmi2Real, fmi2Real, fmi2Boolean, fmi2Real);
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component);
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component);
+EXPORT fmi2Status fmi2Terminate(fmi2Component);
+EXPORT fmi2Status fmi2Reset(fmi2Component);
+EXPORT fmi2Status fmi2GetReal(fmi2Component, const fmi2ValueReference[], size_t, fmi2Real[]);
+EXPORT fmi2Status fmi2GetInteger(fmi2Component, const fmi2ValueReference[], size_t, fmi2Integer[]);
+EXPORT fmi2Status fmi2GetBoolean(fmi2Component, const fmi2ValueReference[], size_t, fmi2Boolean[]);
+EXPORT fmi2Status fmi2GetString(fmi2Component, const fmi2ValueReference[], size_t, fmi2String[]);
+EXPORT fmi2Status fmi2SetReal(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Real[]);
+EXPORT fmi2Status fmi2SetInteger(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Integer[]);
+EXPORT fmi2Status fmi2SetBoolean(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Boolean[]);
+EXPORT fmi2Status fmi2SetString(fmi2Component, const fmi2ValueReference[], size_t, const fmi2String[]);
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component, fmi2FMUstate*);
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component, fmi2FMUstate);
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component, fmi2FMUstate*);
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component, fmi2FMUstate, size_t*);
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component, fmi2FMUstate, fmi2Byte[], size_t);
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component, const fmi2Byte[], size_t, fmi2FMUstate*);
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component, const fmi2ValueReference[], size_t,
+                                               const fmi2ValueReference[], size_t, const fmi2Real[], fmi2Real[]);
+EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component, const fmi2ValueReference[], size_t,
+                                              const fmi2Integer[], const fmi2Real[]);
+EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component, const fmi2ValueReference[], size_t,
+                                               const fmi2Integer[], fmi2Real[]);
+EXPORT fmi2Status fmi2DoStep(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
+EXPORT fmi2Status fmi2CancelStep(fmi2Component);
+EXPORT fmi2Status fmi2GetStatus(fmi2Component, const fmi2StatusKind, fmi2Status*);
+EXPORT fmi2Status fmi2GetRealStatus(fmi2Component, const fmi2StatusKind, fmi2Real*);
+EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component, const fmi2StatusKind, fmi2Integer*);
+EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component, const fmi2StatusKind, fmi2Boolean*);
+EXPORT fmi2Status fmi2GetStringStatus(fmi2Component, const fmi2StatusKind, fmi2String*);
+
+/* Functions taken from the inner library (the two version queries are
+ * answered here: they are fixed by the API this file implements). */
+#define INNER_FUNCTIONS(X)                                                        \
+    X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)                 \
+    X(fmi2SetupExperiment) X(fmi2EnterInitializationMode)                         \
+    X(fmi2ExitInitializationMode) X(fmi2Terminate) X(fmi2Reset)                   \
+    X(fmi2GetReal) X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString)           \
+    X(fmi2SetReal) X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString)           \
+    X(fmi2GetFMUstate) X(fmi2SetFMUstate) X(fmi2FreeFMUstate)                     \
+    X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate)                        \
+    X(fmi2DeSerializeFMUstate) X(fmi2GetDirectionalDerivative)                    \
+    X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives)                \
+    X(fmi2DoStep) X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus)         \
+    X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus) X(fmi2GetStringStatus)
+
+/* Same signatures as ours, so the compiler checks every forwarded call. */
+#define DECLARE_POINTER(name) __typeof__(name)* name;
+static struct {
+    void* handle;
+    INNER_FUNCTIONS(DECLARE_POINTER)
+} inner;
+
+#define INNER_SUFFIX "_pythonfmu.so"
+
+static char inner_path[PATH_MAX];   /* set when this library is loaded */
+static char load_error[PATH_MAX + 256];
+static pthread_once_t load_once = PTHREAD_ONCE_INIT;
+
+/* Locate the inner library while the host's working directory is still the
+ * one this library was loaded from (dladdr may report a relative name). */
+__attribute__((constructor)) static void find_inner_library(void)
+{
+    Dl_info self;
+    char own[PATH_MAX];
+    if (!dladdr(inner_path, &self) || self.dli_fname == NULL) return;
+    if (realpath(self.dli_fname, own) == NULL) snprintf(own, sizeof own, "%s", self.dli_fname);
+    size_t n = strlen(own);
+    if (n > 3 && strcmp(own + n - 3, ".so") == 0) own[n - 3] = '\0';
+    snprintf(inner_path, sizeof inner_path, "%s%s", own, INNER_SUFFIX);
+}
+
+static void load_inner_library(void)
+{
+    if (inner_path[0] == '\0') {
+        snprintf(load_error, sizeof load_error, "cannot determine the path of the FMU's binary");
+        return;
+    }
+    void* handle = dlopen(inner_path, RTLD_NOW | RTLD_LOCAL);
+    if (handle == NULL) {
+        snprintf(load_error, sizeof load_error, "cannot load %s: %s", inner_path, dlerror());
+        return;
+    }
+#define LOAD_POINTER(name)                                                        \
+    if ((inner.name = (__typeof__(inner.name))dlsym(handle, #name)) == NULL) {   \
+        snprintf(load_error, sizeof load_error, "%s lacks %s", inner_path, #name); \
+        dlclose(handle);                                                          \
+        memset(&inner, 0, sizeof inner);                                          \
+        return;                                                                   \
+    }
+    INNER_FUNCTIONS(LOAD_POINTER)
+    inner.handle = handle;
+}
+
+/* The inner library lives exactly as long as this one. */
+__attribute__((destructor)) static void unload_inner_library(void)
+{
+    if (inner.handle != NULL) dlclose(inner.handle);
+}
+
+/* ---- instances ----------------------------------------------------------- */
+
+typedef struct {
+    fmi2Component         component;   /* the inner library's instance */
+    fmi2CallbackFunctions host;        /* the caller's callbacks, as given */
+    fmi2CallbackFunctions given;       /* what the inner library gets; it keeps the pointer */
+    fmi2Status            logged;      /* worst status logged during the current call */
+    fmi2Boolean           debugLogging;
+    size_t                nCategories; /* 0: all categories */
+    char**                categories;
+} Instance;
+
+static void forget_categories(Instance* inst)
+{
+    for (size_t i = 0; i < inst->nCategories; i++) free(inst->categories[i]);
+    free(inst->categories);
+    inst->categories = NULL;
+    inst->nCategories = 0;
+}
+
+/* FMI 2.0 (2.1.3): messages behind fmi2Warning, fmi2Error and fmi2Fatal are
+ * shown to the user; fmi2OK and fmi2Discard messages only in debug mode. */
+static int host_wants(const Instance* inst, fmi2Status status, fmi2String category)
+{
+    if (status != fmi2OK && status != fmi2Discard) return 1;
+    if (!inst->debugLogging) return 0;
+    if (inst->nCategories == 0) return 1;
+    for (size_t i = 0; i < inst->nCategories; i++)
+        if (category != NULL && strcmp(category, inst->categories[i]) == 0) return 1;
+    return 0;
+}
+
+static void shim_logger(fmi2ComponentEnvironment env, fmi2String instanceName, fmi2Status status,
+                        fmi2String category, fmi2String message, ...)
+{
+    Instance* inst = (Instance*)env;
+
+    /* A logged problem is what the call returns; a slave that logged and
+     * returned normally is still usable, so that is never fmi2Fatal. */
+    fmi2Status as_returned = status > fmi2Error ? fmi2Error : status;
+    if (status <= fmi2Fatal && as_returned > inst->logged) inst->logged = as_returned;
+
+    if (inst->host.logger == NULL || !host_wants(inst, status, category)) return;
+
+    /* The message is passed on as plain text, not formatted: pythonfmu hands
+     * over the slave's text as the format and never supplies arguments, so
+     * formatting would read arguments that do not exist as soon as the text
+     * contains '%' (a crash for "%s").  Through "%s" the host formats nothing
+     * either. */
+    inst->host.logger(inst->host.componentEnvironment, instanceName, status, category, "%s",
+                      message != NULL ? message : "");
+}
+
+/* stepFinished gets the environment the host gave, not our record. */
+static void shim_step_finished(fmi2ComponentEnvironment env, fmi2Status status)
+{
+    Instance* inst = (Instance*)env;
+    inst->host.stepFinished(inst->host.componentEnvironment, status);
+}
+
+static fmi2Status worse(fmi2Status returned, fmi2Status logged)
+{
+    if (returned > fmi2Fatal) return returned;  /* fmi2Pending is no severity */
+    return logged > returned ? logged : returned;
+}
+
+/* ---- functions without an instance ------------------------------------ */
+
+const char* fmi2GetTypesPlatform(void) { return "default"; }
+const char* fmi2GetVersion(void) { return "2.0"; }
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn)
+{
+    pthread_once(&load_once, load_inner_library);
+    if (inner.handle == NULL) {
+        if (functions != NULL && functions->logger != NULL)
+            functions->logger(functions->componentEnvironment, instanceName, fmi2Fatal, "logStatusFatal",
+                              "%s", load_error);
+        return NULL;
+    }
+
+    Instance* inst = calloc(1, sizeof *inst);
+    if (inst == NULL) return NULL;
+    if (functions != NULL) inst->host = *functions;
+    inst->debugLogging = loggingOn;
+    inst->given = inst->host;
+    inst->given.logger = shim_logger;
+    inst->given.stepFinished = inst->host.stepFinished != NULL ? shim_step_finished : NULL;
+    inst->given.componentEnvironment = inst;
+
+    /* Debug logging on inside: messages of every status must pass through
+     * shim_logger for the status to be seen at all. */
+    inst->component = inner.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation,
+                                            &inst->given, visible, fmi2True);
+    if (inst->component == NULL) {
+        free(inst);
+        return NULL;
+    }
+    return inst;
+}
+
+void fmi2FreeInstance(fmi2Component c)
+{
+    Instance* inst = (Instance*)c;
+    if (inst == NULL) return;
+    inner.fmi2FreeInstance(inst->component);
+    forget_categories(inst);
+    free(inst);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    Instance* inst = (Instance*)c;
+    if (inst == NULL || (nCategories > 0 && categories == NULL)) return fmi2Error;
+    char** copy = nCategories > 0 ? calloc(nCategories, sizeof *copy) : NULL;
+    if (nCategories > 0 && copy == NULL) return fmi2Error;
+    for (size_t i = 0; i < nCategories; i++) {
+        copy[i] = strdup(categories[i] != NULL ? categories[i] : "");
+        if (copy[i] == NULL) {
+            for (size_t j = 0; j < i; j++) free(copy[j]);
+            free(copy);
+            return fmi2Error;
+        }
+    }
+    forget_categories(inst);
+    inst->debugLogging = loggingOn;
+    inst->nCategories = nCategories;
+    inst->categories = copy;
+
+    inst->logged = fmi2OK;
+    return worse(inner.fmi2SetDebugLogging(inst->component, fmi2True, 0, NULL), inst->logged);
+}
+
+/* ---- forwarded instance functions -------------------------------------- */
+
+/* Define `name` with parameter list `params`; the remaining arguments are
+ * the inner call's arguments, written with `inst->component` for the instance. */
+#define FORWARD(name, params, ...)                                                \
+    fmi2Status name params                                                        \
+    {                                                                             \
+        Instance* inst = (Instance*)c;                                            \
+        if (inst == NULL) return fmi2Error;                                       \
+        inst->logged = fmi2OK;                                                    \
+        fmi2Status returned = inner.name(__VA_ARGS__);                            \
+        return worse(returned, inst->logged);                                     \
+    }
+
+FORWARD(fmi2SetupExperiment,
+        (fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,
+         fmi2Boolean stopTimeDefined, fmi2Real stopTime),
+        inst->component, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime)
+FORWARD(fmi2EnterInitializationMode, (fmi2Component c), inst->component)
+FORWARD(fmi2ExitInitializationMode, (fmi2Component c), inst->component)
+FORWARD(fmi2Terminate, (fmi2Component c), inst->component)
+FORWARD(fmi2Reset, (fmi2Component c), inst->component)
+
+FORWARD(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2GetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2GetString, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2SetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2SetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]),
+        inst->component, vr, nvr, value)
+FORWARD(fmi2SetString, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]),
+        inst->component, vr, nvr, value)
+
+FORWARD(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate* state), inst->component, state)
+FORWARD(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate state), inst->component, state)
+FORWARD(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate* state), inst->component, state)
+FORWARD(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate state, size_t* size),
+        inst->component, state, size)
+FORWARD(fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size),
+        inst->component, state, bytes, size)
+FORWARD(fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate* state),
+        inst->component, bytes, size, state)
+
+FORWARD(fmi2GetDirectionalDerivative,
+        (fmi2Component c, const fmi2ValueReference vUnknown[], size_t nUnknown,
+         const fmi2ValueReference vKnown[], size_t nKnown, const fmi2Real dvKnown[], fmi2Real dvUnknown[]),
+        inst->component, vUnknown, nUnknown, vKnown, nKnown, dvKnown, dvUnknown)
+FORWARD(fmi2SetRealInputDerivatives,
+        (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],
+         const fmi2Real value[]),
+        inst->component, vr, nvr, order, value)
+FORWARD(fmi2GetRealOutputDerivatives,
+        (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[], fmi2Real value[]),
+        inst->component, vr, nvr, order, value)
+
+FORWARD(fmi2DoStep,
+        (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+         fmi2Boolean noSetFMUStatePriorToCurrentPoint),
+        inst->component, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint)
+FORWARD(fmi2CancelStep, (fmi2Component c), inst->component)
+
+FORWARD(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Status* value), inst->component, s, value)
+FORWARD(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Real* value), inst->component, s, value)
+FORWARD(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Integer* value),
+        inst->component, s, value)
+FORWARD(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value),
+        inst->component, s, value)
+FORWARD(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind s, fmi2String* value),
+        inst->component, s, value)
