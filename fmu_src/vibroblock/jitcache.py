@@ -10,7 +10,6 @@ functions from several files) invalidates it.
 from __future__ import annotations
 
 import hashlib
-from functools import lru_cache
 from pathlib import Path
 
 from numba.core import caching, config
@@ -27,9 +26,8 @@ def core_digest(package_dir: Path = PACKAGE_DIR) -> str:
     return digest.hexdigest()
 
 
-@lru_cache(maxsize=None)
-def _package_digest(package_dir: Path) -> str:
-    return core_digest(package_dir)
+# Taken at import: an FMU's extraction folder may be deleted while the process lives on.
+CORE_DIGEST = core_digest(PACKAGE_DIR)
 
 
 class CoreCacheLocator(caching.UserProvidedCacheLocator):
@@ -44,7 +42,7 @@ class CoreCacheLocator(caching.UserProvidedCacheLocator):
     @classmethod
     def get_suitable_cache_subpath(cls, py_file):
         relative = Path(py_file).resolve().parent.relative_to(PACKAGE_DIR).as_posix()
-        folder = hashlib.sha1(f"{_package_digest(PACKAGE_DIR)}/{relative}".encode()).hexdigest()
+        folder = hashlib.sha1(f"{CORE_DIGEST}/{relative}".encode()).hexdigest()
         return f"vibroblock_{folder}"
 
 

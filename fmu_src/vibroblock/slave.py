@@ -19,6 +19,7 @@ error into an fmi2Error return.
 from __future__ import annotations
 
 import math
+import sys
 import traceback
 from pathlib import Path
 
@@ -27,7 +28,7 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variabil
 from pythonfmu.variables import Boolean, Integer, Real
 
 from .block import Block, ModelError
-from .jitcache import PACKAGE_DIR, core_digest
+from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .models import DESCRIPTIONS
 from .parameters import INITIAL_STATES, parameters_for
 from .stepping import INTEGRATORS
@@ -134,7 +135,7 @@ class BlockSlave(Fmi2Slave):
         bundled = Path(resources) / "vibroblock"
         if not bundled.is_dir() or bundled.resolve() == PACKAGE_DIR:
             return True
-        if core_digest(bundled) == core_digest(PACKAGE_DIR):
+        if core_digest(bundled) == CORE_DIGEST:
             return True
         self.log(f"this process already imported a different vibroblock core from {PACKAGE_DIR}; "
                  f"the FMU's own core is {bundled}. Run the FMU in a process without that import.",
@@ -216,9 +217,20 @@ class BlockSlave(Fmi2Slave):
             self.log(f"internal error while restoring the FMU state: {exc!r}", Fmi2Status.error)
 
 
+# pythonfmu 0.7.0's native loader executes the FMU script again in the script module's
+# namespace at every instantiation, then releases a reference to that namespace which it
+# only borrowed (PyModule_GetDict).  Unbalanced, the namespace is freed under the live
+# module after the first instance and the host crashes later.  Every execution of the
+# decorator below therefore hands one reference back, held for the life of the process.
+_NAMESPACES_RELEASED_BY_LOADER: list = []
+
+
 def block_slave(model: str):
     """Class decorator turning ``class BlockX(Fmi2Slave)`` into the facade of model ``model``."""
     def decorate(cls):
+        module = sys.modules.get(cls.__module__)
+        if module is not None:
+            _NAMESPACES_RELEASED_BY_LOADER.append(vars(module))
         attributes = {"model": model, "__doc__": cls.__doc__, "__module__": cls.__module__}
         return type(cls.__name__, (BlockSlave,), attributes)
     return decorate

@@ -42,6 +42,8 @@ from fmpy.logging import addLoggerProxy
 from fmpy.validation import validate_fmu
 from pythonfmu.builder import FmuBuilder
 
+from fmu_testing import FmuLog, do_step, fmu_log, set_real, status_of  # noqa: F401 (fixture)
+
 REPO = Path(__file__).resolve().parents[2]
 
 _spec = importlib.util.spec_from_file_location("status_shim", REPO / "build" / "status_shim.py")
@@ -138,48 +140,6 @@ def fmus(tmp_path_factory):
     )
 
 
-class FmuLog:
-    """The FMU's log messages, caught through fmpy's native logger proxy.
-
-    fmpy's proxy formats the message and calls one process-wide Python logger;
-    ``close`` points it back at fmpy's printer.
-    """
-
-    _printer = fmi2CallbackLoggerTYPE(printLogMessage)  # alive for the whole process
-
-    def __init__(self):
-        self.records: list[tuple[str, int, str, str]] = []
-        self._logger = fmi2CallbackLoggerTYPE(self._log)
-        self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = self._logger
-        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(fmpy.calloc)
-        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(fmpy.free)
-        addLoggerProxy(byref(self.callbacks))
-
-    def _log(self, env, instance, status, category, message):
-        self.records.append(
-            (instance.decode(), status, (category or b"").decode(), message.decode())
-        )
-
-    def close(self):
-        restore = fmi2CallbackFunctions()
-        restore.logger = self._printer
-        addLoggerProxy(byref(restore))
-
-    def of(self, instance):
-        return [r for r in self.records if r[0] == instance]
-
-    def clear(self):
-        self.records.clear()
-
-
-@pytest.fixture
-def fmu_log():
-    log = FmuLog()
-    yield log
-    log.close()
-
-
 @contextlib.contextmanager
 def running(fmus, log, name="probe", wrapped=True, logging_on=False, before_init=None):
     """An initialized FMU2Slave instance; terminated and freed afterwards."""
@@ -200,23 +160,6 @@ def running(fmus, log, name="probe", wrapped=True, logging_on=False, before_init
         slave.terminate()
     finally:
         slave.freeInstance()
-
-
-def status_of(call) -> int:
-    """The FMI status of a call, also when fmpy raises for it."""
-    try:
-        return call()
-    except FMICallException as e:
-        return e.status
-
-
-def set_real(slave, vr, value) -> int:
-    return status_of(lambda: slave.fmi2SetReal(
-        slave.component, (fmi2ValueReference * 1)(vr), 1, (fmi2Real * 1)(value)))
-
-
-def do_step(slave, t, h) -> int:
-    return status_of(lambda: slave.fmi2DoStep(slave.component, t, h, 1))
 
 
 def get(slave, vr) -> float:

@@ -1,0 +1,30 @@
+"""Shared fixtures: FMUs built from the current sources, once per test session."""
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+# Compiled kernels are shared with the Makefile's runs (same folder) unless set otherwise.
+os.environ.setdefault("NUMBA_CACHE_DIR", str(ROOT / ".cache" / "numba"))
+sys.path.insert(0, str(ROOT / "build"))
+# Shared test helpers (tests/fmu_testing.py); test folders mirror the source tree, so
+# they are imported by path (--import-mode=importlib) rather than put on sys.path.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+@pytest.fixture(scope="session")
+def fmu_dir(tmp_path_factory):
+    """BlockA/B/C.fmu built from the working tree into a fresh folder."""
+    import build_fmus
+
+    dest = tmp_path_factory.mktemp("fmus")
+    for name in build_fmus.FMU_NAMES:
+        build_fmus.build(name, dest)
+    return dest
+
+
+@pytest.fixture(scope="session")
+def fmu_path(fmu_dir):
+    return lambda model: str(fmu_dir / f"Block{model}.fmu")

@@ -1,0 +1,239 @@
+"""BlockA/B/C.fmu as an FMI 2.0 master sees them: validation, equality with the core,
+communication-step independence, FMU state, bad input, and a second master."""
+from __future__ import annotations
+
+import contextlib
+import math
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave, fmi2Error, fmi2OK
+from fmpy.validation import validate_fmu
+
+from fmu_testing import do_step, fmu_log, set_real, status_of  # noqa: F401 (fixture)
+from vibroblock import Block
+
+SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
+OUTPUTS = ["x", "z", "vx", "vz", "friction_force", "normal_force", "phi_integral", "penetration", "surface_z"]
+
+
+@pytest.fixture(scope="module")
+def extracted(fmu_path, tmp_path_factory):
+    root = tmp_path_factory.mktemp("extracted")
+    return {m: (read_model_description(fmu_path(m)), extract(fmu_path(m), unzipdir=str(root / m))) for m in "ABC"}
+
+
+@contextlib.contextmanager
+def instance(extracted, model, log, start_values=None, name="block"):
+    md, unzipdir = extracted[model]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName=name)
+    slave.instantiate(callbacks=log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        for key, value in (start_values or {}).items():
+            if isinstance(value, int):
+                slave.setInteger([vr[key]], [value])
+            else:
+                slave.setReal([vr[key]], [value])
+        slave.exitInitializationMode()
+        yield slave, vr
+    finally:
+        slave.freeInstance()
+
+
+def reals(slave, vr, names=OUTPUTS):
+    return slave.getReal([vr[n] for n in names])
+
+
+@pytest.mark.parametrize("model", "ABC")
+def test_fmpy_validation_reports_nothing(fmu_path, model):
+    assert validate_fmu(fmu_path(model)) == []
+    md = read_model_description(fmu_path(model))
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+    names = {v.name for v in md.modelVariables}
+    required = {"m", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "A", "omega", "dt",
+                "plate_z", "plate_v", "plate_a", "x", "z", "vx", "vz", "friction_force", "normal_force",
+                "contact", "slip_count", "phi_integral"}
+    assert required <= names
+    tunable = {v.name for v in md.modelVariables if v.variability == "tunable"}
+    assert tunable == {"A", "omega"}
+
+
+@pytest.mark.parametrize("model", "ABC")
+def test_simulate_fmu_equals_the_core(fmu_path, model):
+    settings = dict(SCALED, A=0.5, omega=0.9)
+    result = simulate_fmu(fmu_path(model), stop_time=200.0, output_interval=0.5,
+                          start_values={**settings, "initial_state": 2})
+    block = Block(model, initial_state=2, **settings)
+    block.start()
+    expected = [block.outputs()]
+    for t in result["time"][1:]:
+        block.advance_to(t)
+        expected.append(block.outputs())
+    for name in OUTPUTS + ["contact", "slip_count"]:
+        np.testing.assert_array_equal(result[name], [row[name] for row in expected], err_msg=name)
+
+
+def test_communication_step_does_not_change_the_trajectory(fmu_path):
+    settings = {**SCALED, "A": 1.2, "omega": 1.1, "initial_state": 2}  # bouncing: chaotic, a strict check
+    runs = {h: simulate_fmu(fmu_path("A"), stop_time=300.0, output_interval=h, start_values=settings)
+            for h in (0.01, 0.75, 300.0)}
+    for h in (0.01, 0.75):
+        at_end = runs[h][-1]
+        for name in OUTPUTS:
+            assert at_end[name] == runs[300.0][-1][name], (h, name)
+    # a coarse grid's samples lie on the fine one
+    fine = runs[0.01][::75]
+    for name in OUTPUTS:
+        np.testing.assert_array_equal(fine[name], runs[0.75][name])
+
+
+@pytest.mark.parametrize("model", "AC")
+def test_saved_state_restores_bit_for_bit_also_in_a_new_instance(extracted, fmu_log, model):
+    settings = {**SCALED, "A": 0.8, "omega": 1.3, "initial_state": 2}
+    with instance(extracted, model, fmu_log, settings) as (slave, vr):
+        t = 0.0
+        for _ in range(20):
+            slave.doStep(t, 0.7)
+            t += 0.7
+        state = slave.getFMUstate()
+        serialized = slave.serializeFMUstate(state)
+        saved_t = t
+        for _ in range(30):
+            slave.doStep(t, 0.7)
+            t += 0.7
+        reference = reals(slave, vr) + [slave.getInteger([vr["slip_count"]])[0]]
+        slave.setFMUstate(state)
+        t = saved_t
+        for _ in range(30):
+            slave.doStep(t, 0.7)
+            t += 0.7
+        assert reals(slave, vr) + [slave.getInteger([vr["slip_count"]])[0]] == reference
+        slave.freeFMUstate(state)
+    with instance(extracted, model, fmu_log, name="fresh") as (fresh, vr):
+        fresh.setFMUstate(fresh.deSerializeFMUstate(serialized))
+        t = saved_t
+        for _ in range(30):
+            fresh.doStep(t, 0.7)
+            t += 0.7
+        assert reals(fresh, vr) + [fresh.getInteger([vr["slip_count"]])[0]] == reference
+
+
+def test_tunable_drive_changes_during_a_run(extracted, fmu_log):
+    with instance(extracted, "A", fmu_log, {"initial_state": 2}) as (slave, vr):
+        slave.doStep(0.0, 10.0)
+        assert slave.getReal([vr["surface_z"]])[0] == 0.0
+        slave.setReal([vr["A"], vr["omega"]], [0.2, 0.5])
+        slave.doStep(10.0, 3.0)
+        assert slave.getReal([vr["surface_z"]])[0] == pytest.approx(0.2 * math.sin(0.5 * 3.0), abs=1e-12)
+
+
+def test_external_input_adds_to_the_drive_and_is_held_at_constant_acceleration(extracted, fmu_log):
+    """Feeding the harmonic plate motion through the inputs at each communication point
+    approaches the internal drive as the communication step shrinks (O(h^3) per step).
+    The plate height under the block (model A) depends on the plate motion only."""
+    amplitude, omega = 0.3, 0.8
+
+    def run(h, external):
+        start = {} if external else {"A": amplitude, "omega": omega}
+        with instance(extracted, "A", fmu_log, start) as (slave, vr):
+            t, zs = 0.0, []
+            for _ in range(int(round(20.0 / h))):
+                if external:
+                    slave.setReal([vr["plate_z"], vr["plate_v"], vr["plate_a"]],
+                                  [amplitude * math.sin(omega * t), amplitude * omega * math.cos(omega * t),
+                                   -amplitude * omega**2 * math.sin(omega * t)])
+                slave.doStep(t, h)
+                t += h
+                zs.append(slave.getReal([vr["surface_z"]])[0])
+            return np.array(zs)
+
+    internal = run(0.5, external=False)
+    errors = [np.max(np.abs(run(h, external=True)[int(round(0.5 / h)) - 1::int(round(0.5 / h))] - internal))
+              for h in (0.5, 0.25)]
+    assert errors[1] < errors[0] / 6  # third order per step: factor 8 expected
+    assert errors[1] < 2e-3
+
+
+def bad_parameter_cases():
+    yield from [("m", -1.0), ("m", math.nan), ("k_n", -1.0), ("k_t", math.inf), ("gamma_n", -0.1),
+                ("gamma_t", -1.0), ("mu_s", -0.5), ("dt", 0.0), ("dt", -4e-4), ("V_d", math.nan),
+                ("plate_z", math.nan), ("plate_a", math.inf)]
+
+
+@pytest.mark.parametrize("name, value", list(bad_parameter_cases()))
+def test_bad_values_give_fmi2error_with_a_message_and_keep_the_state(extracted, fmu_log, name, value):
+    with instance(extracted, "A", fmu_log, dict(SCALED)) as (slave, vr):
+        slave.doStep(0.0, 5.0)
+        before = reals(slave, vr)
+        fmu_log.clear()
+        assert set_real(slave, vr[name], value) == fmi2Error
+        assert any(status == fmi2Error and name in message for _, status, _, message in fmu_log.records)
+        assert reals(slave, vr) == before
+        assert do_step(slave, 5.0, 5.0) == fmi2OK  # the instance goes on from its last good state
+
+
+@pytest.mark.parametrize("h", [0.0, -1.0, math.nan, math.inf])
+def test_bad_step_sizes_give_fmi2error(extracted, fmu_log, h):
+    with instance(extracted, "B", fmu_log) as (slave, vr):
+        slave.doStep(0.0, 1.0)
+        before = reals(slave, vr)
+        fmu_log.clear()
+        assert do_step(slave, 1.0, h) == fmi2Error
+        assert any("step size" in message for *_, message in fmu_log.records)
+        assert reals(slave, vr) == before
+        assert do_step(slave, 1.0, 1.0) == fmi2OK
+
+
+def test_a_wrong_communication_point_gives_fmi2error(extracted, fmu_log):
+    with instance(extracted, "C", fmu_log) as (slave, vr):
+        slave.doStep(0.0, 1.0)
+        assert do_step(slave, 0.5, 1.0) == fmi2Error
+        assert any("differs from the FMU's time" in message for *_, message in fmu_log.records)
+
+
+def test_fixed_parameters_cannot_change_during_a_run(extracted, fmu_log):
+    with instance(extracted, "A", fmu_log) as (slave, vr):
+        slave.doStep(0.0, 1.0)
+        assert set_real(slave, vr["m"], 2.0) == fmi2Error
+        assert slave.getReal([vr["m"]]) == [1.0]
+
+
+def test_an_unstable_dt_is_refused_at_initialization(extracted, fmu_log):
+    md, unzipdir = extracted["A"]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="BlockA", instanceName="stiff")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setReal([vr["k_n"]], [1e8])
+        assert status_of(lambda: slave.fmi2ExitInitializationMode(slave.component)) == fmi2Error
+        assert any("use dt <=" in message for *_, message in fmu_log.records)
+        assert do_step(slave, 0.0, 1.0) == fmi2Error  # not initialized: refused, no crash
+    finally:
+        slave.freeInstance()
+
+
+def test_a_blow_up_is_an_error_not_a_nan(extracted, fmu_log):
+    with instance(extracted, "A", fmu_log, {"k_d": 10.0, "V_d": 1e308}) as (slave, vr):
+        assert do_step(slave, 0.0, 10.0) == fmi2Error
+        assert any("non-finite" in message for *_, message in fmu_log.records)
+        assert all(math.isfinite(v) for v in reals(slave, vr))
+
+
+def test_two_instances_in_one_process_are_independent(extracted, fmu_log):
+    with instance(extracted, "A", fmu_log, {"A": 0.3, "omega": 0.9, "initial_state": 2}, name="one") as (a, vr), \
+         instance(extracted, "A", fmu_log, {"A": 1.5, "omega": 1.1, "initial_state": 2}, name="two") as (b, _):
+        for k in range(50):
+            a.doStep(k * 1.0, 1.0)
+            b.doStep(k * 1.0, 1.0)
+        interleaved = reals(a, vr)
+    with instance(extracted, "A", fmu_log, {"A": 0.3, "omega": 0.9, "initial_state": 2}, name="alone") as (c, vr):
+        for k in range(50):
+            c.doStep(k * 1.0, 1.0)
+        assert reals(c, vr) == interleaved
