@@ -203,14 +203,14 @@ class Block:
             dt = self.drv[L.D_DT]
             grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
             h = min(max(self.time - grid_time, 0.0), dt)
-            x, z, vx, vz, shear, pen, u_n, phi, slips, cos_a = observe(
+            x, z, vx, vz, shear, pen, normal, phi, slips, cos_a = observe(
                 self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, h)
             in_contact = pen > 0.0
             p = self.parameters
             self._observed = {
                 "x": x, "z": z, "vx": vx, "vz": vz,
                 "friction_force": -p["k_t"] * shear if in_contact else 0.0,
-                "normal_force": p["k_n"] * pen - p["gamma_n"] * u_n if in_contact else 0.0,
+                "normal_force": normal,
                 "contact": bool(in_contact),
                 "slip_count": int(slips),
                 "phi_integral": phi,

@@ -27,8 +27,16 @@ from .models import load, profile
 
 
 @njit(inline="always")
+def normal_force(penetration, u_n, prm):
+    if penetration > 0.0:
+        return prm[P_KN] * penetration - prm[P_GN] * u_n
+    return 0.0
+
+
+@njit(inline="always")
 def contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
-    """Penetration, normal and tangential velocity relative to the plate, and the tangent."""
+    """Penetration, normal and tangential velocity relative to the plate, the tangent,
+    and the normal contact force N (0 out of contact)."""
     height, slope = profile(kind, x, prm)
     if slope == 0.0:  # flat plate: skip the square root (model A's hot path)
         cos_a, sin_a = 1.0, 0.0
@@ -39,20 +47,12 @@ def contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     rel_vz = vz - plate_v
     u_n = rel_vz * cos_a - vx * sin_a
     u_t = vx * cos_a + rel_vz * sin_a
-    return penetration, u_n, u_t, cos_a, sin_a
+    return penetration, u_n, u_t, cos_a, sin_a, normal_force(penetration, u_n, prm)
 
 
 @njit(inline="always")
-def normal_force(penetration, u_n, prm):
-    if penetration > 0.0:
-        return prm[P_KN] * penetration - prm[P_GN] * u_n
-    return 0.0
-
-
-@njit(inline="always")
-def force(kind, x, t, penetration, u_n, u_t, cos_a, sin_a, shear, prm):
+def force(kind, x, t, penetration, normal, u_t, cos_a, sin_a, shear, prm):
     """Total force on the block (callers divide by m once per step, not per call)."""
-    normal = normal_force(penetration, u_n, prm)
     tangential = -prm[P_GT] * u_t
     if penetration > 0.0:
         tangential -= prm[P_KT] * shear
@@ -63,7 +63,7 @@ def force(kind, x, t, penetration, u_n, u_t, cos_a, sin_a, shear, prm):
 
 
 @njit(inline="always")
-def friction_rule(shear, penetration, u_n, prm):
+def friction_rule(shear, penetration, normal, prm):
     """The paper's reset rule: F = 0 once detached, or when |k_t F| >= mu_s N.
 
     Returns the new shear displacement and whether a Coulomb reset of a loaded
@@ -71,7 +71,7 @@ def friction_rule(shear, penetration, u_n, prm):
     """
     if penetration <= 0.0:
         return 0.0, False
-    if abs(prm[P_KT] * shear) >= prm[P_MUS] * normal_force(penetration, u_n, prm):
+    if abs(prm[P_KT] * shear) >= prm[P_MUS] * normal:
         return 0.0, shear != 0.0
     return shear, False
 

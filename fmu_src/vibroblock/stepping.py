@@ -104,10 +104,10 @@ def _advance_euler(kind, y, cnt, drv, prm, n_steps):
 
     t = t0 + n * dt
     plate_z, plate_v = _plate_at_step(drv, s, c, t)
-    pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     done = 0
     while done < n_steps:
-        fx, fz = force(kind, x, t, pen, u_n, u_t, cos_a, sin_a, shear, prm)
+        fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
         engaged = pen > 0.0
         vx += dt_m * fx
         vz += dt_m * fz
@@ -123,14 +123,14 @@ def _advance_euler(kind, y, cnt, drv, prm, n_steps):
             else:
                 s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
             plate_z, plate_v = _plate_at_step(drv, s, c, t)
-        pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+        pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
         if engaged:
             shear += dt * u_t
-        shear, reset = friction_rule(shear, pen, u_n, prm)
+        shear, reset = friction_rule(shear, pen, normal, prm)
         slips += reset
         dv = vx - v_drive
         phi, phi_c = kahan_add(phi, phi_c, dt * dv * dv)
-        if done % FINITE_CHECK == 0 and not is_finite_state(x, z, vx, vz, shear):
+        if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
     if not is_finite_state(x, z, vx, vz, shear):
         return -1
@@ -142,8 +142,8 @@ def _advance_euler(kind, y, cnt, drv, prm, n_steps):
 
 @njit(inline="always")
 def _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v):
-    pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
-    fx, fz = force(kind, x, t, pen, u_n, u_t, cos_a, sin_a, shear, prm)
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_shear = u_t if pen > 0.0 else 0.0
     dv = vx - prm[P_VD]
     return fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv
@@ -199,12 +199,12 @@ def _advance_rk4(kind, y, cnt, drv, prm, n_steps):
         pz1, pv1 = _plate_at_step(drv, s, c, t_new)
         x, z, vx, vz, shear, d_phi = rk4_step(kind, prm, x, z, vx, vz, shear, t, t_new - t,
                                               pz0, pv0, pz_half, pv_half, pz1, pv1)
-        pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-        shear, reset = friction_rule(shear, pen, u_n, prm)
+        pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        shear, reset = friction_rule(shear, pen, normal, prm)
         slips += reset
         phi, phi_c = kahan_add(phi, phi_c, d_phi)
         t, pz0, pv0 = t_new, pz1, pv1
-        if done % FINITE_CHECK == 0 and not is_finite_state(x, z, vx, vz, shear):
+        if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
     if not is_finite_state(x, z, vx, vz, shear):
         return -1
@@ -230,33 +230,33 @@ def observe(kind, method, y, cnt, drv, prm, h):
     A communication point between two grid points is reached by one scratch step of
     length h from the grid state, so outputs are at the requested time while the
     stored trajectory stays on the grid (and so independent of the communication
-    steps).  Returns (x, z, vx, vz, F, penetration, u_n, phi, slips, cos a).
+    steps).  Returns (x, z, vx, vz, F, penetration, N, phi, slips, cos a).
     """
     t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, slips = y[Y_PHI], cnt[C_SLIPS]
     plate_z, plate_v = plate_at_time(drv, cnt, prm, t)
-    pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     if h > 0.0:
         pz1, pv1 = plate_at_time(drv, cnt, prm, t + h)
         if method == RK4:
             pzh, pvh = plate_at_time(drv, cnt, prm, t + 0.5 * h)
             x, z, vx, vz, shear, d_phi = rk4_step(kind, prm, x, z, vx, vz, shear, t, h,
                                                   plate_z, plate_v, pzh, pvh, pz1, pv1)
-            pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+            pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
         else:
-            fx, fz = force(kind, x, t, pen, u_n, u_t, cos_a, sin_a, shear, prm)
+            fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
             engaged = pen > 0.0
             vx += h * fx / prm[P_M]
             vz += h * fz / prm[P_M]
             x += h * vx
             z += h * vz
-            pen, u_n, u_t, cos_a, sin_a = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+            pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
             if engaged:
                 shear += h * u_t
             dv = vx - prm[P_VD]
             d_phi = h * dv * dv
-        shear, reset = friction_rule(shear, pen, u_n, prm)
+        shear, reset = friction_rule(shear, pen, normal, prm)
         slips += reset
         phi += d_phi
-    return x, z, vx, vz, shear, pen, u_n, phi, slips, cos_a
+    return x, z, vx, vz, shear, pen, normal, phi, slips, cos_a

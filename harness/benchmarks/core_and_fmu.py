@@ -1,0 +1,97 @@
+"""Benchmark: speed of the physics core and the cost of going through an FMU.
+
+    python -m harness.benchmarks.core_and_fmu [--fmu-dir build/fmus] [--substeps 2e7]
+
+Prints, measured side by side in one run on one core:
+
+1. internal steps per second of the core, per model and integrator (the scaled
+   stick-slip set, once with the plate at rest and once vibrating);
+2. fmpy -> FMU cost: a fixed amount of work (internal steps) split into communication
+   steps of 1, 10, 100 and 1000 internal steps, the overhead per doStep against the bare
+   core doing the same work, and the FMU's slowdown relative to the core.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+
+from vibroblock import INTEGRATORS, Block
+
+ROOT = Path(__file__).resolve().parents[2]
+SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
+DT = 4e-4
+
+
+def best_of(repeats, run):
+    return min(run() for _ in range(repeats))
+
+
+def core_seconds(model, integrator, steps, **parameters):
+    def run():
+        block = Block(model, integrator, initial_state=2, **SCALED, **parameters)
+        block.start()
+        block.advance_to(DT)  # compile/load kernels outside the timing
+        start = time.perf_counter()
+        block.advance_to(DT * (steps + 1))
+        return time.perf_counter() - start
+    return best_of(3, run)
+
+
+def fmu_seconds(unzipdir, md, steps, substeps_per_step):
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName="bench")
+    slave.instantiate()
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setReal([vr[k] for k in SCALED], list(SCALED.values()))
+        slave.exitInitializationMode()
+        h = substeps_per_step * DT
+        n_calls = steps // substeps_per_step
+        slave.doStep(0.0, h)
+        outputs = [vr["x"], vr["vx"]]
+        start = time.perf_counter()
+        for k in range(1, n_calls + 1):
+            slave.doStep(k * h, h)
+            slave.getReal(outputs)  # a master reads outputs after each step
+        return time.perf_counter() - start, n_calls
+    finally:
+        slave.terminate()
+        slave.freeInstance()
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fmu-dir", type=Path, default=ROOT / "build" / "fmus")
+    parser.add_argument("--substeps", type=float, default=2e7, help="internal steps per core measurement")
+    parser.add_argument("--fmu-work", type=float, default=2e5, help="internal steps per FMU measurement")
+    args = parser.parse_args(argv)
+    steps = int(args.substeps)
+
+    print(f"1. core speed, dt = {DT}, {steps:.0e} internal steps, best of 3")
+    print(f"   {'model':5} {'integrator':18} {'plate':9} {'Msteps/s':>9} {'ns/step':>8}")
+    for model in "ABC":
+        for integrator in INTEGRATORS:
+            for label, drive in (("at rest", {}), ("vibrating", {"A": 0.3, "omega": 0.8})):
+                seconds = core_seconds(model, integrator, steps, **drive)
+                print(f"   {model:5} {integrator:18} {label:9} {steps / seconds / 1e6:9.1f} {seconds / steps * 1e9:8.2f}")
+
+    work = int(args.fmu_work)
+    md = read_model_description(str(args.fmu_dir / "BlockA.fmu"))
+    unzipdir = extract(str(args.fmu_dir / "BlockA.fmu"))
+    bare = core_seconds("A", "symplectic_euler", work)
+    print(f"\n2. fmpy -> BlockA.fmu, {work:.0e} internal steps in all; bare core {bare * 1e3:.2f} ms")
+    print(f"   {'steps/doStep':>12} {'doSteps':>8} {'FMU s':>8} {'overhead/doStep':>16} {'FMU/core':>9}")
+    for per_step in (1, 10, 100, 1000):
+        seconds, calls = fmu_seconds(unzipdir, md, work, per_step)
+        overhead = (seconds - bare) / calls
+        print(f"   {per_step:12d} {calls:8d} {seconds:8.3f} {overhead * 1e6:13.1f} us {seconds / bare:9.2f}")
+
+
+if __name__ == "__main__":
+    main()
