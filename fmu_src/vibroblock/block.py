@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from . import interface
 from . import layout as L
 from .models import MODELS, load, profile
 from .parameters import INITIAL_STATES, parameters_for
@@ -21,8 +22,7 @@ from .stepping import INTEGRATORS, RK4, advance, observe
 # axis below ~5.6): margins that keep the ringing of the contact resolved.
 STABILITY_LIMIT = {"symplectic_euler": 1.0, "rk4": 4.0}
 
-OUTPUTS = ("x", "z", "vx", "vz", "friction_force", "normal_force", "contact", "slip_count", "phi_integral",
-           "penetration", "surface_z")
+OUTPUTS = tuple(interface.OUTPUTS)
 
 
 class ModelError(ValueError):

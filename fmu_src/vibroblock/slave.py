@@ -30,29 +30,9 @@ from pythonfmu.variables import Boolean, Integer, Real
 from .block import Block, ModelError
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .models import DESCRIPTIONS
-from .parameters import INITIAL_STATES, parameters_for
+from .interface import INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS
+from .parameters import parameters_for
 from .stepping import INTEGRATORS
-
-INPUTS = {
-    "plate_z": "external plate height, added to the internal drive [delta_0]",
-    "plate_v": "external plate velocity [delta_0/tau_0]",
-    "plate_a": "external plate acceleration [delta_0/tau_0^2]; over a communication step the "
-               "plate follows plate_z + plate_v tau + plate_a tau^2/2",
-}
-REAL_OUTPUTS = {
-    "x": "horizontal block position [delta_0]",
-    "z": "vertical block position [delta_0]",
-    "vx": "horizontal block velocity [delta_0/tau_0]",
-    "vz": "vertical block velocity [delta_0/tau_0]",
-    "friction_force": "tangential spring force -k_t F along the plate's tangent, 0 out of contact [m_0 delta_0/tau_0^2]",
-    "normal_force": "normal contact force k_n delta - gamma_n u_n, 0 out of contact [m_0 delta_0/tau_0^2]",
-    "phi_integral": "integral of (vx - V_d)^2 dt since the start [delta_0^2/tau_0]",
-    "penetration": "penetration delta = (Z_p - z) cos(alpha) along the surface normal; > 0 in contact [delta_0]",
-    "surface_z": "height of the plate surface Z_p(x, t) under the block [delta_0]",
-}
-INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
-INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
-
 
 class BlockSlave(Fmi2Slave):
     """FMU facade over ``vibroblock.Block``: registers variables, maps FMI calls, reports errors."""
@@ -91,24 +71,18 @@ class BlockSlave(Fmi2Slave):
             description=f"initial state: {INITIAL_CHOICES}",
             getter=lambda: self.block.initial_state,
             setter=lambda value: self._guard(self.block.set_initial_state, int(value))))
-        for name, text in INPUTS.items():
+        for name, (unit, text) in INPUTS.items():
             self.register_variable(Real(
-                name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous, description=text,
+                name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+                description=f"{text} [{unit}]",
                 getter=lambda name=name: self.plate_input[name],
                 setter=lambda value, name=name: self._guard(self._set_input, name, value)))
-        for name, text in REAL_OUTPUTS.items():
-            self.register_variable(Real(
-                name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-                initial=Fmi2Initial.calculated, description=text, getter=lambda name=name: self._output(name)))
-        self.register_variable(Boolean(
-            "contact", causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
-            initial=Fmi2Initial.calculated, description="block penetrates the plate (delta > 0)",
-            getter=lambda: self._output("contact")))
-        self.register_variable(Integer(
-            "slip_count", causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
-            initial=Fmi2Initial.calculated,
-            description="Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since the start",
-            getter=lambda: self._output("slip_count")))
+        variable_types = {"Real": Real, "Integer": Integer, "Boolean": Boolean}
+        for name, (kind, unit, text) in OUTPUTS.items():
+            variability = Fmi2Variability.continuous if kind == "Real" else Fmi2Variability.discrete
+            self.register_variable(variable_types[kind](
+                name, causality=Fmi2Causality.output, variability=variability, initial=Fmi2Initial.calculated,
+                description=f"{text} [{unit}]" if unit else text, getter=lambda name=name: self._output(name)))
 
     def _output(self, name):
         if not self.block.started:

@@ -1,0 +1,51 @@
+"""The Block FMUs' interface as a markdown table (``python -m vibroblock.interface``).
+
+The README's interface table is this module's output; a test keeps the two equal.
+"""
+from .parameters import INITIAL_STATES, MODEL_DEFAULTS, PARAMETERS
+from .stepping import INTEGRATORS
+
+INPUTS = {
+    "plate_z": ("delta_0", "external plate height, added to the internal drive"),
+    "plate_v": ("delta_0/tau_0", "external plate velocity"),
+    "plate_a": ("delta_0/tau_0^2", "external plate acceleration; over a communication step the plate follows "
+                "plate_z + plate_v tau + plate_a tau^2/2"),
+}
+OUTPUTS = {
+    "x": ("Real", "delta_0", "horizontal block position"),
+    "z": ("Real", "delta_0", "vertical block position"),
+    "vx": ("Real", "delta_0/tau_0", "horizontal block velocity"),
+    "vz": ("Real", "delta_0/tau_0", "vertical block velocity"),
+    "friction_force": ("Real", "m_0 delta_0/tau_0^2",
+                       "tangential spring force -k_t F along the plate's tangent, 0 out of contact"),
+    "normal_force": ("Real", "m_0 delta_0/tau_0^2", "normal contact force k_n delta - gamma_n u_n, 0 out of contact"),
+    "contact": ("Boolean", "", "block penetrates the plate (delta > 0)"),
+    "slip_count": ("Integer", "", "Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since the start"),
+    "phi_integral": ("Real", "delta_0^2/tau_0", "integral of (vx - V_d)^2 dt since the start"),
+    "penetration": ("Real", "delta_0", "penetration delta = (Z_p - z) cos(alpha) along the surface normal; > 0 in contact"),
+    "surface_z": ("Real", "delta_0", "height of the plate surface Z_p(x, t) under the block"),
+}
+INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
+INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
+
+
+def markdown_table() -> str:
+    rows = ["| name | kind | models | unit | default | meaning |", "|---|---|---|---|---|---|"]
+    for p in PARAMETERS:
+        kind = "parameter, tunable" if p.tunable else "parameter"
+        default = f"{p.default:g}"
+        overridden = [m for m, values in MODEL_DEFAULTS.items() if p.name in values]
+        if overridden:
+            default += f" ({', '.join(overridden)}: {MODEL_DEFAULTS[overridden[0]][p.name]:g})"
+        rows.append(f"| `{p.name}` | {kind} | {p.models} | {p.unit} | {default} | {p.description} |")
+    rows.append(f"| `integrator` | parameter (Integer) | ABC | | 0 | {INTEGRATOR_CHOICES} |")
+    rows.append(f"| `initial_state` | parameter (Integer) | ABC | | 0 | {INITIAL_CHOICES} |")
+    for name, (unit, text) in INPUTS.items():
+        rows.append(f"| `{name}` | input | ABC | {unit} | 0 | {text} |")
+    for name, (kind, unit, text) in OUTPUTS.items():
+        rows.append(f"| `{name}` | output ({kind}) | ABC | {unit} | | {text} |")
+    return "\n".join(rows)
+
+
+if __name__ == "__main__":
+    print(markdown_table())
