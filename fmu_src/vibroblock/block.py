@@ -41,7 +41,7 @@ class Block:
     """
 
     def __init__(self, model: str = "A", integrator: str = "symplectic_euler", initial_state: int = 0,
-                 **parameters: float):
+                 energy_balance: bool = False, **parameters: float):
         if model not in MODELS:
             raise ModelError(f"unknown model {model!r}; choose one of {sorted(MODELS)}")
         self.model = model
@@ -49,10 +49,12 @@ class Block:
         self._specs = {p.name: p for p in parameters_for(model)}
         self.parameters = {name: spec.default for name, spec in self._specs.items()}
         self.started = False
+        self.energy_balance = False
         self.integrator = "symplectic_euler"
         self.initial_state = 0
         self.set_integrator(integrator)
         self.set_initial_state(initial_state)
+        self.set_energy_balance(energy_balance)
         for name, value in parameters.items():
             self.set_parameter(name, value)
 
@@ -80,6 +82,11 @@ class Block:
             raise ModelError(f"unknown integrator {integrator!r}; choose one of {names}")
         self._require_not_started("integrator")
         self.integrator = integrator
+
+    def set_energy_balance(self, track: bool) -> None:
+        """Account work, dissipation and stored energy during the run (costs ~1/3 more per step)."""
+        self._require_not_started("energy_balance")
+        self.energy_balance = bool(track)
 
     def set_initial_state(self, mode: int) -> None:
         if mode not in INITIAL_STATES:
@@ -125,6 +132,11 @@ class Block:
         self._set_initial_state()
         self.started = True
         self._observed = None
+        # The normal spring's energy starts at k_n delta^2 / 2 and then integrates its power.
+        penetration = self.output("penetration")
+        self.y[L.Y_E_NORMAL] = 0.5 * p["k_n"] * penetration**2 if penetration > 0.0 else 0.0
+        self._observed = None
+        self.y[L.Y_E_START] = self._stored_energy(*self._observation_raw()[:5], self.y[L.Y_E_NORMAL], t0)
 
     def _set_initial_state(self) -> None:
         p, y = self.parameters, self.y
@@ -176,7 +188,8 @@ class Block:
         target = math.floor((t_end - t0) / dt + 1e-9)
         todo = target - int(self.cnt[L.C_STEP])
         if todo > 0:
-            done = advance(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, todo)
+            done = advance(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, todo,
+                           self.energy_balance)
             if done < 0:
                 raise ModelError(
                     f"the state became non-finite while integrating from t = {self.time:g} to t = {t_end:g} "
@@ -197,16 +210,33 @@ class Block:
     def output(self, name: str):
         return self._observables()[name]
 
+    def _observation_raw(self):
+        dt = self.drv[L.D_DT]
+        grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
+        h = self.time - grid_time
+        if h < 1e-9 * dt:  # on the grid up to rounding of the master's time
+            h = 0.0
+        return observe(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, min(h, dt),
+                       self.energy_balance)
+
+    def _stored_energy(self, x, z, vx, vz, shear, e_normal, t):
+        """Kinetic + drive spring + tangential spring + normal spring energy."""
+        p = self.parameters
+        stretch = x - p["V_d"] * t
+        return (0.5 * p["m"] * (vx * vx + vz * vz) + 0.5 * p["k_d"] * stretch * stretch
+                + 0.5 * p["k_t"] * shear * shear + e_normal)
+
     def _observables(self) -> dict:
         if self._observed is None:
             self._require_started()
-            dt = self.drv[L.D_DT]
-            grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
-            h = min(max(self.time - grid_time, 0.0), dt)
-            x, z, vx, vz, shear, pen, normal, phi, slips, cos_a = observe(
-                self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, h)
+            (x, z, vx, vz, shear, pen, normal, cos_a, phi, slips,
+             work, dissipated, e_normal, t) = self._observation_raw()
             in_contact = pen > 0.0
             p = self.parameters
+            residual = 0.0
+            if self.energy_balance:
+                stored = self._stored_energy(x, z, vx, vz, shear, e_normal, t)
+                residual = stored - self.y[L.Y_E_START] - work + dissipated
             self._observed = {
                 "x": x, "z": z, "vx": vx, "vz": vz,
                 "friction_force": -p["k_t"] * shear if in_contact else 0.0,
@@ -216,6 +246,9 @@ class Block:
                 "phi_integral": phi,
                 "penetration": pen,
                 "surface_z": z + pen / cos_a,
+                "work_input": work,
+                "energy_dissipated": dissipated,
+                "energy_residual": residual,
             }
         return self._observed
 
@@ -229,6 +262,7 @@ class Block:
         self._require_started()
         return {
             "model": self.model, "integrator": self.integrator, "initial_state": self.initial_state,
+            "energy_balance": self.energy_balance,
             "parameters": dict(self.parameters), "time": self.time,
             "y": self.y.tolist(), "cnt": self.cnt.tolist(), "drv": self.drv.tolist(), "prm": self.prm.tolist(),
         }
@@ -248,6 +282,7 @@ class Block:
         self.y, self.cnt, self.drv, self.prm = y, cnt, drv, prm
         self.parameters = dict(state["parameters"])
         self.integrator, self.initial_state = state["integrator"], state["initial_state"]
+        self.energy_balance = bool(state.get("energy_balance", False))
         self.time = float(state["time"])
         self.started = True
         self._observed = None

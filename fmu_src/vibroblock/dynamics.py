@@ -63,6 +63,31 @@ def force(kind, x, t, penetration, normal, u_t, cos_a, sin_a, shear, prm):
 
 
 @njit(inline="always")
+def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal, shear, plate_v, prm):
+    """Rates of the energy balance: work done on the block by the drive's far end, the
+    plate and the load; power dissipated by the dashpots; power stored in the normal
+    spring (-k_n delta u_n, which is d(k_n delta^2 / 2)/dt on a flat plate).
+
+    With kinetic energy K, drive-spring energy k_d (x - V_d t)^2 / 2 and tangential
+    spring energy k_t F^2 / 2, Newton's law gives
+    d(K + E_drive + E_normal + E_shear)/dt = work rate - dissipation rate, exactly;
+    the energy a reset releases (k_t F^2 / 2) counts as dissipated.
+    """
+    tangential = -prm[P_GT] * u_t
+    dissipation = prm[P_GT] * u_t * u_t
+    storage = 0.0
+    if penetration > 0.0:
+        tangential -= prm[P_KT] * shear
+        dissipation += prm[P_GN] * u_n * u_n
+        storage = -prm[P_KN] * penetration * u_n
+    load_x, load_z = load(kind, cos_a, sin_a, prm)
+    work = (prm[P_KD] * (prm[P_VD] * t - x) * prm[P_VD]
+            + plate_v * (normal * cos_a + tangential * sin_a)
+            + load_x * vx + load_z * vz)
+    return work, dissipation, storage
+
+
+@njit(inline="always")
 def friction_rule(shear, penetration, normal, prm):
     """The paper's reset rule: F = 0 once detached, or when |k_t F| >= mu_s N.
 

@@ -24,8 +24,16 @@ OUTPUTS = {
     "phi_integral": ("Real", "delta_0^2/tau_0", "integral of (vx - V_d)^2 dt since the start"),
     "penetration": ("Real", "delta_0", "penetration delta = (Z_p - z) cos(alpha) along the surface normal; > 0 in contact"),
     "surface_z": ("Real", "delta_0", "height of the plate surface Z_p(x, t) under the block"),
+    "work_input": ("Real", "m_0 delta_0^2/tau_0^2", "work done on the block by the drive, the plate and the load "
+                   "since the start (with energy_balance)"),
+    "energy_dissipated": ("Real", "m_0 delta_0^2/tau_0^2", "energy dissipated by the dashpots and released by "
+                          "friction resets since the start (with energy_balance)"),
+    "energy_residual": ("Real", "m_0 delta_0^2/tau_0^2", "stored energy change - work + dissipated: zero for the "
+                        "exact dynamics, the integration error otherwise (with energy_balance)"),
 }
 INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
+ENERGY_BALANCE = "account work, dissipation and stored energy (outputs work_input, energy_dissipated, " \
+    "energy_residual; about a third more time per step)"
 INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
 
 
@@ -40,6 +48,7 @@ def markdown_table() -> str:
         rows.append(f"| `{p.name}` | {kind} | {p.models} | {p.unit} | {default} | {p.description} |")
     rows.append(f"| `integrator` | parameter (Integer) | ABC | | 0 | {INTEGRATOR_CHOICES} |")
     rows.append(f"| `initial_state` | parameter (Integer) | ABC | | 0 | {INITIAL_CHOICES} |")
+    rows.append(f"| `energy_balance` | parameter (Boolean) | ABC | | false | {ENERGY_BALANCE} |")
     for name, (unit, text) in INPUTS.items():
         rows.append(f"| `{name}` | input | ABC | {unit} | 0 | {text} |")
     for name, (kind, unit, text) in OUTPUTS.items():

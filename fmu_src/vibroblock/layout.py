@@ -11,9 +11,11 @@ PRM_NAMES = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d",
 
 # Continuous state, float64 array ``y``: block position and velocity, the tangential
 # spring's displacement F (Cundall-Strack), the integral of (vx - V_d)^2 and the
-# compensation term of its Kahan sum (the integral runs over up to 1e12 steps).
-Y_X, Y_Z, Y_VX, Y_VZ, Y_F, Y_PHI, Y_PHI_C = range(7)
-N_Y = 7
+# compensation term of its Kahan sum (the integral runs over up to 1e12 steps), and the
+# energy balance: work done on the block, energy dissipated (dashpots and resets), energy
+# stored in the normal spring, and the stored energy at the start.
+Y_X, Y_Z, Y_VX, Y_VZ, Y_F, Y_PHI, Y_PHI_C, Y_WORK, Y_DISSIPATED, Y_E_NORMAL, Y_E_START = range(11)
+N_Y = 11
 
 # Integer counters, int64 array ``cnt``: internal steps taken since the start (time is
 # t0 + n dt, never accumulated), Coulomb resets, and the step at which the drive phase

@@ -30,7 +30,7 @@ from pythonfmu.variables import Boolean, Integer, Real
 from .block import Block, ModelError
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .models import DESCRIPTIONS
-from .interface import INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS
+from .interface import ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS
 from .parameters import parameters_for
 from .stepping import INTEGRATORS
 
@@ -71,6 +71,10 @@ class BlockSlave(Fmi2Slave):
             description=f"initial state: {INITIAL_CHOICES}",
             getter=lambda: self.block.initial_state,
             setter=lambda value: self._guard(self.block.set_initial_state, int(value))))
+        self.register_variable(Boolean(
+            "energy_balance", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description=ENERGY_BALANCE, getter=lambda: self.block.energy_balance,
+            setter=lambda value: self._guard(self.block.set_energy_balance, bool(value))))
         for name, (unit, text) in INPUTS.items():
             self.register_variable(Real(
                 name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
@@ -169,6 +173,7 @@ class BlockSlave(Fmi2Slave):
                 "block": self.block.get_state() if self.block.started else None,
                 "parameters": dict(self.block.parameters),
                 "integrator": self.block.integrator, "initial_state": self.block.initial_state,
+                "energy_balance": self.block.energy_balance,
                 "start_time": self.start_time, "plate_input": dict(self.plate_input),
                 "input_changed": self._input_changed,
             }
@@ -178,7 +183,8 @@ class BlockSlave(Fmi2Slave):
 
     def _set_fmu_state(self, state):
         try:
-            block = Block(self.model, state["integrator"], state["initial_state"], **state["parameters"])
+            block = Block(self.model, state["integrator"], state["initial_state"], state["energy_balance"],
+                          **state["parameters"])
             if state["block"] is not None:
                 block.set_state(state["block"])
             self.start_time = float(state["start_time"])

@@ -9,6 +9,9 @@ Contract every integrator obeys (a new one must too):
   new state, and a Coulomb reset of a loaded spring increments cnt[C_SLIPS];
 * the plate drive is evaluated as a function of n alone, so advancing n1 + n2 steps in
   two calls gives the same bits as n1 + n2 steps in one call;
+* with ``track_energy`` it accumulates the work done on the block, the energy
+  dissipated (dashpots, and k_t F^2/2 at every reset) and the normal spring's energy
+  (``dynamics.energy_rates``), with the scheme's own order;
 * it returns the number of steps taken, or -1 if the state stopped being finite, in
   which case the arrays are left as they were on entry (the last good state).
 
@@ -28,9 +31,10 @@ import math
 
 from numba import njit
 
-from .dynamics import contact, force, friction_rule, plate_motion
+from .dynamics import contact, energy_rates, force, friction_rule, plate_motion
 from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z,
-                     D_OMEGA, D_PHASE, D_T0, P_M, P_VD, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_X, Y_Z)
+                     D_OMEGA, D_PHASE, D_T0, P_KT, P_M, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ,
+                     Y_WORK, Y_X, Y_Z)
 
 SYMPLECTIC_EULER, RK4 = 0, 1
 INTEGRATORS = {"symplectic_euler": SYMPLECTIC_EULER, "rk4": RK4}
@@ -77,11 +81,11 @@ def is_finite_state(x, z, vx, vz, shear):
 
 
 @njit(cache=True)
-def advance(kind, method, y, cnt, drv, prm, n_steps):
+def advance(kind, method, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by n_steps internal steps with the chosen integrator (see module doc)."""
     if method == RK4:
-        return _advance_rk4(kind, y, cnt, drv, prm, n_steps)
-    return _advance_euler(kind, y, cnt, drv, prm, n_steps)
+        return _advance_rk4(kind, y, cnt, drv, prm, n_steps, track_energy)
+    return _advance_euler(kind, y, cnt, drv, prm, n_steps, track_energy)
 
 
 @njit(inline="always")
@@ -90,94 +94,132 @@ def _plate_at_step(drv, s, c, t):
                         t - drv[D_EXT_T])
 
 
+@njit(inline="always")
+def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plate_v, pz1, pv1, track_energy):
+    """One semi-implicit Euler step of length h from a state whose contact quantities
+    ``contact_now`` are known; returns the new state, its contact quantities, and the
+    increments of phi, work, dissipation and normal-spring energy."""
+    pen, u_n, u_t, cos_a, sin_a, normal = contact_now
+    fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
+    d_work = d_dissipated = d_normal = 0.0
+    if track_energy:
+        work, dissipation, storage = energy_rates(kind, x, vx, vz, t, pen, u_n, u_t, cos_a, sin_a, normal,
+                                                  shear, plate_v, prm)
+        d_work, d_dissipated, d_normal = h * work, h * dissipation, h * storage
+    engaged = pen > 0.0
+    vx += h_over_m * fx
+    vz += h_over_m * fz
+    x += h * vx
+    z += h * vz
+    contact_new = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+    if engaged:
+        shear += h * contact_new[2]
+    dv = vx - prm[P_VD]
+    return x, z, vx, vz, shear, contact_new, h * dv * dv, d_work, d_dissipated, d_normal
+
+
 @njit(cache=True)
-def _advance_euler(kind, y, cnt, drv, prm, n_steps):
-    t0, dt, v_drive = drv[D_T0], drv[D_DT], prm[P_VD]
+def _advance_euler(kind, y, cnt, drv, prm, n_steps, track_energy):
+    t0, dt = drv[D_T0], drv[D_DT]
     dt_m = dt / prm[P_M]
+    half_kt = 0.5 * prm[P_KT]
     # A plate at rest (no drive, no input) needs no kinematics in the loop.
     plate_moves = drv[D_AMP] != 0.0 or drv[D_EXT_V] != 0.0 or drv[D_EXT_A] != 0.0
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
     n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
     rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
     s, c = drive_sin_cos(drv, cnt, n)
 
     t = t0 + n * dt
     plate_z, plate_v = _plate_at_step(drv, s, c, t)
-    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    state_contact = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     done = 0
     while done < n_steps:
-        fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
-        engaged = pen > 0.0
-        vx += dt_m * fx
-        vz += dt_m * fz
-        x += dt * vx
-        z += dt * vz
         n += 1
         done += 1
-        t = t0 + n * dt
+        t_new = t0 + n * dt
         if plate_moves:
-            if (n - anchor) % RESYNC == 0:
+            if ((n - anchor) & (RESYNC - 1)) == 0:
                 phase = drive_phase(drv, cnt, n)
                 s, c = math.sin(phase), math.cos(phase)
             else:
                 s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
-            plate_z, plate_v = _plate_at_step(drv, s, c, t)
-        pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
-        if engaged:
-            shear += dt * u_t
-        shear, reset = friction_rule(shear, pen, normal, prm)
+            pz1, pv1 = _plate_at_step(drv, s, c, t_new)
+        else:
+            pz1, pv1 = plate_z, plate_v
+        x, z, vx, vz, shear, state_contact, d_phi, d_work, d_dissipated, d_normal = euler_step(
+            kind, prm, x, z, vx, vz, shear, t, dt, dt_m, state_contact, plate_v, pz1, pv1, track_energy)
+        loaded = shear
+        shear, reset = friction_rule(shear, state_contact[0], state_contact[5], prm)
         slips += reset
-        dv = vx - v_drive
-        phi, phi_c = kahan_add(phi, phi_c, dt * dv * dv)
+        phi, phi_c = kahan_add(phi, phi_c, d_phi)
+        if track_energy:
+            work += d_work
+            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
+            e_normal += d_normal
+        t, plate_z, plate_v = t_new, pz1, pv1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
     if not is_finite_state(x, z, vx, vz, shear):
         return -1
     y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
     y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
     cnt[C_STEP], cnt[C_SLIPS] = n, slips
     return done
 
 
 @njit(inline="always")
-def _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v):
+def _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
+    """Accelerations, dF/dt, and the rates of the quadratures (phi, work, dissipation,
+    normal-spring energy) at one stage."""
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_shear = u_t if pen > 0.0 else 0.0
     dv = vx - prm[P_VD]
-    return fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv
+    work = dissipation = storage = 0.0
+    if track_energy:
+        work, dissipation, storage = energy_rates(kind, x, vx, vz, t, pen, u_n, u_t, cos_a, sin_a, normal,
+                                                  shear, plate_v, prm)
+    return fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv, work, dissipation, storage
 
 
 @njit(inline="always")
-def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, pz1, pv1):
-    """One classical RK4 step of length h; returns the new state and the phi increment."""
+def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, pz1, pv1, track_energy):
+    """One classical RK4 step of length h; returns the new state and the increments of
+    phi, work, dissipation and normal-spring energy."""
     half = 0.5 * h
-    ax1, az1, df1, dp1 = _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0)
-    ax2, az2, df2, dp2 = _rk4_rhs(kind, prm, x + half * vx, z + half * vz, vx + half * ax1, vz + half * az1,
-                                  shear + half * df1, t + half, pz_half, pv_half)
+    ax1, az1, df1, p1, w1, d1, e1 = _rk4_rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0, track_energy)
     vx2, vz2 = vx + half * ax1, vz + half * az1
-    ax3, az3, df3, dp3 = _rk4_rhs(kind, prm, x + half * vx2, z + half * vz2, vx + half * ax2, vz + half * az2,
-                                  shear + half * df2, t + half, pz_half, pv_half)
+    ax2, az2, df2, p2, w2, d2, e2 = _rk4_rhs(kind, prm, x + half * vx, z + half * vz, vx2, vz2,
+                                             shear + half * df1, t + half, pz_half, pv_half, track_energy)
     vx3, vz3 = vx + half * ax2, vz + half * az2
-    ax4, az4, df4, dp4 = _rk4_rhs(kind, prm, x + h * vx3, z + h * vz3, vx + h * ax3, vz + h * az3,
-                                  shear + h * df3, t + h, pz1, pv1)
+    ax3, az3, df3, p3, w3, d3, e3 = _rk4_rhs(kind, prm, x + half * vx2, z + half * vz2, vx3, vz3,
+                                             shear + half * df2, t + half, pz_half, pv_half, track_energy)
     vx4, vz4 = vx + h * ax3, vz + h * az3
+    ax4, az4, df4, p4, w4, d4, e4 = _rk4_rhs(kind, prm, x + h * vx3, z + h * vz3, vx4, vz4,
+                                             shear + h * df3, t + h, pz1, pv1, track_energy)
     sixth = h / 6.0
-    x_new = x + sixth * (vx + 2.0 * vx2 + 2.0 * vx3 + vx4)
-    z_new = z + sixth * (vz + 2.0 * vz2 + 2.0 * vz3 + vz4)
-    vx_new = vx + sixth * (ax1 + 2.0 * ax2 + 2.0 * ax3 + ax4)
-    vz_new = vz + sixth * (az1 + 2.0 * az2 + 2.0 * az3 + az4)
-    shear_new = shear + sixth * (df1 + 2.0 * df2 + 2.0 * df3 + df4)
-    d_phi = sixth * (dp1 + 2.0 * dp2 + 2.0 * dp3 + dp4)
-    return x_new, z_new, vx_new, vz_new, shear_new, d_phi
+    return (x + sixth * (vx + 2.0 * vx2 + 2.0 * vx3 + vx4),
+            z + sixth * (vz + 2.0 * vz2 + 2.0 * vz3 + vz4),
+            vx + sixth * (ax1 + 2.0 * ax2 + 2.0 * ax3 + ax4),
+            vz + sixth * (az1 + 2.0 * az2 + 2.0 * az3 + az4),
+            shear + sixth * (df1 + 2.0 * df2 + 2.0 * df3 + df4),
+            sixth * (p1 + 2.0 * p2 + 2.0 * p3 + p4),
+            sixth * (w1 + 2.0 * w2 + 2.0 * w3 + w4),
+            sixth * (d1 + 2.0 * d2 + 2.0 * d3 + d4),
+            sixth * (e1 + 2.0 * e2 + 2.0 * e3 + e4))
 
 
 @njit(cache=True)
-def _advance_rk4(kind, y, cnt, drv, prm, n_steps):
+def _advance_rk4(kind, y, cnt, drv, prm, n_steps, track_energy):
     t0, dt = drv[D_T0], drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
+    half_kt = 0.5 * prm[P_KT]
     n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
     rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
     half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
@@ -190,19 +232,24 @@ def _advance_rk4(kind, y, cnt, drv, prm, n_steps):
         pz_half, pv_half = _plate_at_step(drv, sh, ch, t + 0.5 * dt)
         n += 1
         done += 1
-        if (n - anchor) % RESYNC == 0:
+        if ((n - anchor) & (RESYNC - 1)) == 0:
             phase = drive_phase(drv, cnt, n)
             s, c = math.sin(phase), math.cos(phase)
         else:
             s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
         t_new = t0 + n * dt
         pz1, pv1 = _plate_at_step(drv, s, c, t_new)
-        x, z, vx, vz, shear, d_phi = rk4_step(kind, prm, x, z, vx, vz, shear, t, t_new - t,
-                                              pz0, pv0, pz_half, pv_half, pz1, pv1)
+        x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(
+            kind, prm, x, z, vx, vz, shear, t, t_new - t, pz0, pv0, pz_half, pv_half, pz1, pv1, track_energy)
         pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        loaded = shear
         shear, reset = friction_rule(shear, pen, normal, prm)
         slips += reset
         phi, phi_c = kahan_add(phi, phi_c, d_phi)
+        if track_energy:
+            work += d_work
+            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
+            e_normal += d_normal
         t, pz0, pv0 = t_new, pz1, pv1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
@@ -210,6 +257,7 @@ def _advance_rk4(kind, y, cnt, drv, prm, n_steps):
         return -1
     y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
     y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
     cnt[C_STEP], cnt[C_SLIPS] = n, slips
     return done
 
@@ -224,39 +272,40 @@ def plate_at_time(drv, cnt, prm, t):
 
 
 @njit(cache=True)
-def observe(kind, method, y, cnt, drv, prm, h):
+def observe(kind, method, y, cnt, drv, prm, h, track_energy):
     """State at t_n + h, 0 <= h < dt, without touching the stored state.
 
     A communication point between two grid points is reached by one scratch step of
     length h from the grid state, so outputs are at the requested time while the
     stored trajectory stays on the grid (and so independent of the communication
-    steps).  Returns (x, z, vx, vz, F, penetration, N, phi, slips, cos a).
+    steps).  Returns (x, z, vx, vz, F, penetration, N, cos a, phi, slips, work,
+    dissipated, normal-spring energy, t).
     """
     t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, slips = y[Y_PHI], cnt[C_SLIPS]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
     plate_z, plate_v = plate_at_time(drv, cnt, prm, t)
-    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    state_contact = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     if h > 0.0:
         pz1, pv1 = plate_at_time(drv, cnt, prm, t + h)
         if method == RK4:
             pzh, pvh = plate_at_time(drv, cnt, prm, t + 0.5 * h)
-            x, z, vx, vz, shear, d_phi = rk4_step(kind, prm, x, z, vx, vz, shear, t, h,
-                                                  plate_z, plate_v, pzh, pvh, pz1, pv1)
-            pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+            x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(
+                kind, prm, x, z, vx, vz, shear, t, h, plate_z, plate_v, pzh, pvh, pz1, pv1, track_energy)
+            state_contact = contact(kind, x, z, vx, vz, pz1, pv1, prm)
         else:
-            fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
-            engaged = pen > 0.0
-            vx += h * fx / prm[P_M]
-            vz += h * fz / prm[P_M]
-            x += h * vx
-            z += h * vz
-            pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-            if engaged:
-                shear += h * u_t
-            dv = vx - prm[P_VD]
-            d_phi = h * dv * dv
-        shear, reset = friction_rule(shear, pen, normal, prm)
+            x, z, vx, vz, shear, state_contact, d_phi, d_work, d_dissipated, d_normal = euler_step(
+                kind, prm, x, z, vx, vz, shear, t, h, h / prm[P_M], state_contact, plate_v, pz1, pv1,
+                track_energy)
+        loaded = shear
+        shear, reset = friction_rule(shear, state_contact[0], state_contact[5], prm)
         slips += reset
         phi += d_phi
-    return x, z, vx, vz, shear, pen, normal, phi, slips, cos_a
+        if track_energy:
+            work += d_work
+            dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+            e_normal += d_normal
+        t += h
+    pen, u_n, u_t, cos_a, sin_a, normal = state_contact
+    return x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, work, dissipated, e_normal, t

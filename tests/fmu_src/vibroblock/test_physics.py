@@ -132,3 +132,28 @@ def test_friction_never_exceeds_the_coulomb_bound():
     assert np.all(np.abs(friction[loaded]) < 0.5 * normal[loaded])
     assert np.all(friction[contact == 0] == 0.0)
     assert loaded.mean() > 0.5  # the check is not vacuous
+
+
+@pytest.mark.parametrize("model", "ABC")
+def test_energy_balance_closes_as_the_step_shrinks(model):
+    """Work in = stored energy change + dissipation (dashpots and resets), up to the
+    integration error: first order for symplectic Euler, far smaller for RK4."""
+    def residual(integrator, dt):
+        block = Block(model, integrator, energy_balance=True, dt=dt, A=0.3, omega=1.2, initial_state=2, **SCALED)
+        block.start()
+        block.advance_to(1500.0)
+        out = block.outputs()
+        assert out["work_input"] != 0.0 and out["energy_dissipated"] > 0.0
+        return abs(out["energy_residual"]) / out["energy_dissipated"]
+
+    euler = [residual("symplectic_euler", dt) for dt in (2e-3, 1e-3)]
+    assert euler[1] == pytest.approx(euler[0] / 2, rel=0.25)
+    assert residual("rk4", 2e-3) < 1e-3 * euler[0]
+
+
+def test_energy_accounting_is_off_by_default_and_costs_nothing_then():
+    block = Block("A", A=0.3, omega=1.2, **SCALED)
+    block.start()
+    block.advance_to(100.0)
+    out = block.outputs()
+    assert out["work_input"] == out["energy_dissipated"] == out["energy_residual"] == 0.0
