@@ -7,8 +7,8 @@ export NUMBA_CACHE_DIR := $(CURDIR)/.cache/numba
 export MPLBACKEND := Agg
 
 INSTALLED := $(VENV)/.installed
-FMUS := build/fmus/BlockA.fmu build/fmus/BlockB.fmu build/fmus/BlockC.fmu
-FMU_SOURCES := $(shell find fmu_src -name '*.py') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c
+FMUS := build/fmus/BlockA.fmu build/fmus/BlockB.fmu build/fmus/BlockC.fmu build/fmus/Excitation.fmu
+FMU_SOURCES := $(shell find fmu_src -name '*.py' -o -name '*.npz') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c
 
 .PHONY: setup fmus run test benchmark clean
 

@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 SOURCES = ROOT / "fmu_src"
 CORE = SOURCES / "vibroblock"
 DEFAULT_DEST = ROOT / "build" / "fmus"
-FMU_NAMES = ("BlockA", "BlockB", "BlockC")
+FMU_NAMES = ("BlockA", "BlockB", "BlockC", "Excitation")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(SOURCES))

@@ -23,6 +23,8 @@ from .stepping import INTEGRATORS, RK4, advance, observe
 STABILITY_LIMIT = {"symplectic_euler": 1.0, "rk4": 4.0}
 
 OUTPUTS = tuple(interface.OUTPUTS)
+# A time within this fraction of dt of a grid point is that grid point.
+GRID_TOLERANCE = 1e-6
 
 
 class ModelError(ValueError):
@@ -184,8 +186,9 @@ class Block:
             raise ModelError(f"cannot advance from t = {self.time!r} to t = {t_end!r}: "
                              "the end time must be finite and later than the current time")
         dt, t0 = self.drv[L.D_DT], self.drv[L.D_T0]
-        # Grid point at or just below t_end; the tolerance absorbs rounding of t_end.
-        target = math.floor((t_end - t0) / dt + 1e-9)
+        # Grid point at or just below t_end.  The tolerance absorbs masters that
+        # accumulate time (t += h drifts by ~1e-10 over thousands of steps).
+        target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
         todo = target - int(self.cnt[L.C_STEP])
         if todo > 0:
             done = advance(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, todo,
@@ -214,7 +217,7 @@ class Block:
         dt = self.drv[L.D_DT]
         grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
         h = self.time - grid_time
-        if h < 1e-9 * dt:  # on the grid up to rounding of the master's time
+        if h < GRID_TOLERANCE * dt:  # on the grid up to rounding of the master's time
             h = 0.0
         return observe(self.kind, INTEGRATORS[self.integrator], self.y, self.cnt, self.drv, self.prm, min(h, dt),
                        self.energy_balance)
