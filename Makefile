@@ -27,7 +27,7 @@ $(FMUS) &: $(INSTALLED) $(FMU_SOURCES)
 	$(PY) build/build_fmus.py
 
 run: fmus
-	$(PY) examples/fig1b_stick_slip_vs_sliding.py
+	$(PY) -m harness.main
 
 # pytest exits non-zero when no test ran (exit code 5), so an empty run fails here too.
 test: fmus

@@ -285,6 +285,11 @@ void fmi2FreeInstance(fmi2Component c)
 {
     Instance* inst = (Instance*)c;
     if (inst == NULL) return;
+    /* pythonfmu 0.7.0 forwards the messages still queued when an instance is
+     * destroyed, and with debug logging on that crashes the host (seen when an
+     * instance is freed right after fmi2Instantiate).  Nothing logged while
+     * freeing is of use to the host, so logging goes off first. */
+    inner.fmi2SetDebugLogging(inst->component, fmi2False, 0, NULL);
     inner.fmi2FreeInstance(inst->component);
     forget_categories(inst);
     free(inst);

@@ -253,3 +253,24 @@ def test_libcosim_runs_the_fmus_with_the_same_results_as_fmpy(fmu_path, model):
     # the last bit, which the FMU absorbs (it steps on its own grid of dt).
     for name in names:
         np.testing.assert_array_equal(other[name], reference[name], err_msg=name)
+
+
+def test_an_instance_freed_right_after_instantiation_does_not_crash_the_host(fmu_path, tmp_path):
+    """Run in a child process: a crash there would otherwise take the test runner down."""
+    import subprocess
+    import sys
+    import textwrap
+
+    script = textwrap.dedent(f"""
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import FMU2Slave
+        md = read_model_description({fmu_path("A")!r})
+        unzipdir = extract({fmu_path("A")!r})
+        for logging_on in (False, True):
+            slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="BlockA", instanceName="brief")
+            slave.instantiate(loggingOn=logging_on)
+            slave.freeInstance()
+        print("freed")
+    """)
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert done.returncode == 0 and "freed" in done.stdout, done.stderr[-2000:]
