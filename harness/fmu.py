@@ -154,15 +154,15 @@ class FmuInstance:
             self._slave.instantiate(callbacks=self._callbacks)
         except Exception as exc:
             raise FmuError("fmi2Instantiate", None, self._log, str(exc)) from None
-        self.state = "instantiated"
+        self.state = "instantiated"  # -> configuring -> running; reset() -> instantiated; closed
+        self.runs = 0
         try:
             self._check_health()
         except FmuError:
             # A slave that failed its own start-up checks has been seen to crash in
             # fmi2FreeInstance (pythonfmu 0.7): leave it allocated rather than end the process.
             self.state = "closed"
-            raise  # -> configuring -> running; reset() -> instantiated; closed
-        self.runs = 0
+            raise
 
     # ------------------------------------------------------------------ plumbing
     def _make_callbacks(self) -> fmi2CallbackFunctions:
@@ -175,10 +175,10 @@ class FmuInstance:
             del self._log[:-LOG_LINES_KEPT]
 
         callbacks = fmi2CallbackFunctions()
-        callbacks.logger = fmi2CallbackLoggerTYPE(keep)
+        self._logger = fmi2CallbackLoggerTYPE(keep)  # the C callback must outlive the instance
+        callbacks.logger = self._logger
         callbacks.allocateMemory = defaultCallbacks.allocateMemory
         callbacks.freeMemory = defaultCallbacks.freeMemory
-        self._keep = keep  # the C callback must outlive the instance
         try:
             from fmpy.logging import addLoggerProxy
 
@@ -214,8 +214,13 @@ class FmuInstance:
         is well.
         """
         name = next(iter(self.interface.parameters), None)
-        if name is not None:
+        if name is None:
+            return
+        try:
             self.reader([name])()
+        except FmuError as exc:
+            raise FmuError("fmi2Instantiate", exc.status, exc.log, "the FMU reported an error while starting up") \
+                from None
 
     # ------------------------------------------------------------------ values
     def set(self, values: Mapping[str, float | int | bool]) -> None:
@@ -280,7 +285,10 @@ class FmuInstance:
         self.runs += 1
 
     def do_step(self, time: float, step: float) -> None:
-        self._call(f"fmi2DoStep(t={time!r}, h={step!r})", self._slave.doStep, time, step)
+        try:
+            self._call("fmi2DoStep", self._slave.doStep, time, step)
+        except FmuError as exc:  # the call's arguments are formatted only when they are needed
+            raise FmuError(f"fmi2DoStep(t={time!r}, h={step!r})", exc.status, exc.log) from None
 
     def reset(self) -> None:
         self._call("fmi2Reset", self._slave.reset)

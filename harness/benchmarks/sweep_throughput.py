@@ -16,8 +16,9 @@ Prints, measured side by side in one run:
    difference to the bare run with reads.  And the Dask cost per point on top
    (1-worker sweep time per point minus the in-process harness time).
 
-Other processes competing for the cores spoil the speed-up; the load average before
-the measurement is printed with the figures.
+Other processes competing for the cores spoil the speed-up; the cores they kept busy
+just before the measurement, and the cores the workers kept busy, are printed with
+the figures.
 """
 from __future__ import annotations
 
@@ -116,9 +117,11 @@ def main(argv=None) -> int:
     base = PointSettings(RunSettings.for_model("A", horizon=args.horizon, output_interval=args.interval),
                          ObservableSettings(transient=args.horizon / 5))
     n = len(grid)
-    load = os.getloadavg()[0]
-    print(f"load average before the measurement: {load:.2f}" + (" (other processes are busy: the speed-up "
-                                                                "will be low)" if load > 0.5 else ""))
+    import psutil
+
+    busy = psutil.cpu_percent(interval=2.0) / 100 * (os.cpu_count() or 1)
+    print(f"cores busy with other work just before the measurement: {busy:.2f}"
+          + (" (the machine is shared: the figures below are pessimistic)" if busy > 0.2 else ""))
     print(f"sweep: {n} points of model A (scaled set), horizon {args.horizon:g}, output interval "
           f"{args.interval:g}, dt {base.run.integration.dt:g}, {os.cpu_count()} cores")
 

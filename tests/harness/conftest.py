@@ -1,4 +1,9 @@
-"""Shared fixtures of the harness tests (runs, sweeps, stores, continuation)."""
+"""Fixtures of the harness tests (runs, sweeps, stores, continuation).
+
+The FMU comes from the session's fresh build of the working tree (``fmu_dir`` in
+tests/conftest.py), so a rebuild of build/fmus while the tests run cannot swap the FMU
+(and its physics core) under them.
+"""
 from __future__ import annotations
 
 import os
@@ -7,21 +12,16 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
-# FMU instances in this process and in the workers it starts load compiled kernels from here.
-os.environ.setdefault("NUMBA_CACHE_DIR", str(REPO / ".cache" / "numba"))
 
 
 @pytest.fixture(scope="session")
-def fmu_a() -> Path:
-    path = REPO / "build" / "fmus" / "BlockA.fmu"
-    if not path.is_file():
-        pytest.fail(f"{path} is missing: build the FMUs first (make fmus)")
-    return path
+def fmu_a(fmu_dir) -> Path:
+    return Path(fmu_dir) / "BlockA.fmu"
 
 
 @pytest.fixture
 def subprocess_env() -> dict:
-    """Environment for harness processes started by a test."""
+    """Environment for harness processes started by a test (same compiled-kernel cache)."""
     env = dict(os.environ)
     env["NUMBA_CACHE_DIR"] = os.environ["NUMBA_CACHE_DIR"]
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO), env.get("PYTHONPATH")]))

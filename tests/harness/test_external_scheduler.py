@@ -7,7 +7,6 @@ import signal
 import socket
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import psutil
@@ -66,7 +65,8 @@ def test_a_sweep_runs_through_an_external_scheduler(fmu_a, tmp_path, subprocess_
     from distributed import Client
 
     grid = Grid.parse(["A=0,4", "omega=0.6,0.8"])
-    base = PointSettings(RunSettings.for_model("A", fmu=str(fmu_a), horizon=1500.0), ObservableSettings(transient=300.0))
+    base = PointSettings(RunSettings.for_model("A", fmu=str(fmu_a), horizon=1500.0),
+                         ObservableSettings(transient=300.0))
     with dask_cluster(tmp_path, subprocess_env) as address:
         client = Client(address, timeout=60, set_as_default=False)
         try:

@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from harness.fmu import FmuError, FmuInstance, FmuInterface, InstancePool, extract_fmu, fmu_sha256
-from harness.observables import SLIDING, STICK_SLIP, observe
+from harness.observables import SLIDING, STICK_SLIP
 from harness.run import run_point, simulate
 from harness.settings import (InitialCondition, Integration, ObservableSettings, PointSettings, RunSettings,
                               PRESETS)
@@ -107,3 +107,35 @@ def test_classification_of_known_cases(fmu_a):
     assert flying.slip_count == 0 and math.isnan(flying.stick_time_mean)
     assert flying.contact_fraction < 0.5
     assert flying.drift_velocity == pytest.approx(PRESETS["scaled"]["V_d"], rel=0.02)
+
+
+OTHER_CORE_SCRIPT = """
+import sys, zipfile
+from harness.fmu import FmuError, FmuInstance
+source, other = sys.argv[1], sys.argv[2]
+with zipfile.ZipFile(source) as zin, zipfile.ZipFile(other, "w", zipfile.ZIP_DEFLATED) as zout:
+    for item in zin.infolist():
+        data = zin.read(item)
+        if item.filename == "resources/vibroblock/layout.py":
+            data += b"\\n# a different core\\n"
+        zout.writestr(item, data)
+first = FmuInstance(source)
+first.start({"k_d": 1e-2})
+try:
+    FmuInstance(other)
+except FmuError as exc:
+    print("refused:", str(exc).replace("\\n", " "))
+first.close()
+print("process still alive")
+"""
+
+
+def test_an_fmu_with_another_core_in_the_same_process_is_refused_cleanly(fmu_a, tmp_path, subprocess_env):
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", OTHER_CORE_SCRIPT, str(fmu_a), str(tmp_path / "Other.fmu")],
+                          env=subprocess_env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "refused: fmi2Instantiate failed (error)" in done.stdout and "different vibroblock core" in done.stdout
+    assert done.stdout.strip().endswith("process still alive")

@@ -1,0 +1,68 @@
+"""The main job: every claim study, the paper's figures and ``out/report.md``.
+
+    python -m harness.main [--quick] [--scheduler ADDRESS] [--workers N] [--out out]
+
+Runs the studies of :mod:`harness.claims` on a Dask LocalCluster (or the scheduler
+given), persisting every sweep point and task under ``<out>/store`` so an interrupted
+job resumes where it stopped; draws the figures; writes the measured values
+(``<out>/claims.json``) and the report (``<out>/report.md``).  ``--quick`` is a
+one-minute version at a coarser resolution.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+from .claims import RESOLUTIONS, Runner, run_studies, save_studies
+from .fmu import REPO_ROOT
+from .report import write_report
+from .sweep import INLINE, Execution, close_client, open_client
+
+def main(argv: list[str] | None = None) -> Path:
+    parser = argparse.ArgumentParser(prog="python -m harness.main", description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="coarse one-minute version")
+    parser.add_argument("--resolution", choices=sorted(RESOLUTIONS), help="explicit resolution (overrides --quick)")
+    parser.add_argument("--scheduler", help="address of an existing Dask scheduler, or 'inline' (no Dask)")
+    parser.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
+    parser.add_argument("--out", type=Path, default=REPO_ROOT / "out", help="folder of figures, store and report")
+    parser.add_argument("--fmu-dir", type=Path, help="folder holding BlockA/B/C.fmu (default: build/fmus)")
+    parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--report-only", action="store_true", help="redraw figures and report from <out>/claims.json")
+    args = parser.parse_args(argv)
+
+    resolution = RESOLUTIONS[args.resolution or ("quick" if args.quick else "default")]
+    os.environ.setdefault("NUMBA_CACHE_DIR", str(REPO_ROOT / ".cache" / "numba"))
+    out = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    execution = Execution(scheduler=args.scheduler, workers=args.workers, progress=not args.no_progress)
+    started = time.perf_counter()
+    if args.report_only:
+        from .claims import load_studies
+
+        studies = load_studies(out / "claims.json")
+        path = write_report(studies, out, (), {"resolution": "from claims.json"})
+        print(f"report: {path}")
+        return path
+    client = None if args.scheduler == INLINE else open_client(execution)
+    try:
+        fmus = {m: args.fmu_dir / f"Block{m}.fmu" for m in "ABC"} if args.fmu_dir else None
+        runner = Runner(out / "store", resolution, execution, client, fmus)
+        studies = run_studies(runner, progress=not args.no_progress)
+    finally:
+        if client is not None:
+            close_client(client)
+    save_studies(studies, out / "claims.json")
+    elapsed = time.perf_counter() - started
+    header = {"resolution": resolution.name, "points computed / reused from the store":
+              f"{runner.points_computed} / {runner.points_reused}", "wall time": f"{elapsed:.0f} s",
+              "measured values": "claims.json"}
+    path = write_report(studies, out, (), header)
+    print(f"report: {path}  ({elapsed:.0f} s, resolution {resolution.name})")
+    return path
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
