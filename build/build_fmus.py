@@ -2,19 +2,22 @@
 
 Each ``fmu_src/<Name>.py`` facade script becomes ``<dest>/<Name>.fmu`` (FMI 2.0
 co-simulation) with the physics core ``fmu_src/vibroblock`` bundled as pythonfmu
-project files.  After pythonfmu has written the archive, two finishing steps make it
-a complete FMI 2.0 FMU:
+project files.  After pythonfmu has written the archive, finishing steps make it a
+complete, reproducible FMI 2.0 FMU:
 
+* the native status shim is installed in front of pythonfmu's library, so that a
+  call the model rejects returns fmi2Error instead of fmi2OK (see build/status_shim.py);
 * the model description gets the ``InitialUnknowns`` section that FMI 2.0 requires
   for outputs with ``initial="calculated"`` (pythonfmu does not write it);
-* the native status shim is installed in front of pythonfmu's library, so that a
-  call the model rejects returns fmi2Error instead of fmi2OK (see build/status_shim.py).
+* the archive is written deterministically (see ``finish_archive``).
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import sys
 import tempfile
+import uuid
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree
@@ -23,6 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 SOURCES = ROOT / "fmu_src"
 CORE = SOURCES / "vibroblock"
 DEFAULT_DEST = ROOT / "build" / "fmus"
+FIXED_TIMESTAMP = (1980, 1, 1, 0, 0, 0)  # the earliest a zip archive can record
 FMU_NAMES = ("BlockA", "BlockB", "BlockC", "Excitation")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -46,14 +50,36 @@ def complete_model_description(xml_text: bytes) -> bytes:
     return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def rewrite_member(fmu: Path, member: str, transform) -> None:
-    """Replace one member of a zip archive (zipfile cannot update in place)."""
+def finish_archive(fmu: Path) -> None:
+    """Complete the model description and make the archive reproducible.
+
+    The same sources give the same bytes: members in name order with a fixed time
+    stamp, no generation time, and a GUID derived from the archive's content (a master
+    can tell two builds apart by it, and a result store can reuse points across
+    rebuilds of unchanged sources).
+    """
+    with zipfile.ZipFile(fmu) as src:
+        members = {item.filename: (item, src.read(item)) for item in src.infolist() if not item.is_dir()}
+    content = hashlib.sha256()
+    for name in sorted(members):
+        if name != "modelDescription.xml":
+            content.update(name.encode())
+            content.update(members[name][1])
+    root = ElementTree.fromstring(complete_model_description(members["modelDescription.xml"][1]))
+    root.set("guid", "{%s}" % uuid.uuid5(uuid.NAMESPACE_URL, f"vibroblock:{content.hexdigest()}"))
+    root.attrib.pop("generationDateAndTime", None)
+    item, _ = members["modelDescription.xml"]
+    members["modelDescription.xml"] = (item, ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True))
+
     with tempfile.NamedTemporaryFile(dir=fmu.parent, suffix=".fmu", delete=False) as tmp:
         tmp_path = Path(tmp.name)
-    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp_path, "w", zipfile.ZIP_DEFLATED) as dst:
-        for item in src.infolist():
-            data = src.read(item)
-            dst.writestr(item, transform(data) if item.filename == member else data)
+    with zipfile.ZipFile(tmp_path, "w", zipfile.ZIP_DEFLATED) as dst:
+        for name in sorted(members):
+            item, data = members[name]
+            fixed = zipfile.ZipInfo(name, date_time=FIXED_TIMESTAMP)
+            fixed.external_attr = item.external_attr
+            fixed.compress_type = zipfile.ZIP_DEFLATED
+            dst.writestr(fixed, data)
     tmp_path.chmod(0o644)
     tmp_path.replace(fmu)
 
@@ -65,9 +91,9 @@ def build(name: str, dest: Path) -> Path:
     fmu = FmuBuilder.build_FMU(script, dest=dest, project_files=[CORE],
                                canGetAndSetFMUstate=True, canSerializeFMUstate=True)
     fmu = Path(fmu)
-    rewrite_member(fmu, "modelDescription.xml", complete_model_description)
     from status_shim import wrap_fmu
     wrap_fmu(fmu)
+    finish_archive(fmu)
     return fmu
 
 
