@@ -2,7 +2,7 @@
 
 The README's interface table is this module's output; a test keeps the two equal.
 """
-from .parameters import INITIAL_STATES, MODEL_DEFAULTS, PARAMETERS
+from .parameters import INITIAL_STATES, MODEL_DEFAULTS, PARAMETERS, SCENE_OPTIONS
 from .stepping import INTEGRATORS
 
 INPUTS = {
@@ -49,6 +49,8 @@ def markdown_table() -> str:
     rows.append(f"| `integrator` | parameter (Integer) | ABC | | 0 | {INTEGRATOR_CHOICES} |")
     rows.append(f"| `initial_state` | parameter (Integer) | ABC | | 0 | {INITIAL_CHOICES} |")
     rows.append(f"| `energy_balance` | parameter (Boolean) | ABC | | false | {ENERGY_BALANCE} |")
+    for name, (models, text) in SCENE_OPTIONS.items():
+        rows.append(f"| `{name}` | parameter (Boolean) | {models} | | false | {text} |")
     for name, (unit, text) in INPUTS.items():
         rows.append(f"| `{name}` | input | ABC | {unit} | 0 | {text} |")
     for name, (kind, unit, text) in OUTPUTS.items():

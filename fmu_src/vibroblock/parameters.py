@@ -75,6 +75,20 @@ MODEL_DEFAULTS: dict[str, dict[str, float]] = {
     "C": {"V_d": 2e-4, "k_d": 5e-6},
 }
 
+# Scene reductions (``vibroblock.scenes``): physics a scene may drop.  Boolean
+# parameters, off by default; name -> (models, description).  One table for the FMU
+# variables, the core's validation and the README.
+SCENE_OPTIONS = {
+    "rigid_contact": ("ABC", "rigid instead of compliant normal contact: the block rides the surface until the "
+                      "normal force would pull, then flies and lands with restitution 0 (drops k_n, gamma_n and "
+                      "their dt limit; detachment at max plate acceleration = load/m)"),
+    "frozen_vertical": ("A", "vertical motion frozen on the steady in-contact orbit of the drive (external plate "
+                        "acceleration pressing quasi-statically); a guard hands over to the full model when that "
+                        "orbit would lose contact (A >= A_c(omega))"),
+    "coulomb_friction": ("ABC", "plain Coulomb friction instead of the history-dependent spring: stuck while the "
+                         "needed tangential force stays below mu_s N, else sliding against mu_s N (drops k_t, F)"),
+}
+
 INITIAL_STATES = {
     0: "equilibrium: at rest (vx_start, vz_start) at the rest penetration under the plate's initial position",
     1: "given: x_start, z_start, vx_start, vz_start as set",

@@ -31,7 +31,7 @@ from .block import Block, ModelError
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .models import DESCRIPTIONS
 from .interface import ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS
-from .parameters import parameters_for
+from .parameters import SCENE_OPTIONS, parameters_for
 from .stepping import INTEGRATORS
 
 class BlockSlave(Fmi2Slave):
@@ -75,6 +75,12 @@ class BlockSlave(Fmi2Slave):
             "energy_balance", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=ENERGY_BALANCE, getter=lambda: self.block.energy_balance,
             setter=lambda value: self._guard(self.block.set_energy_balance, bool(value))))
+        for name, (models, text) in SCENE_OPTIONS.items():  # only the reductions this model offers
+            if self.model in models:
+                self.register_variable(Boolean(
+                    name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed, description=text,
+                    getter=lambda name=name: self.block.scene[name],
+                    setter=lambda value, name=name: self._guard(self.block.set_scene_option, name, bool(value))))
         for name, (unit, text) in INPUTS.items():
             self.register_variable(Real(
                 name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
@@ -173,7 +179,7 @@ class BlockSlave(Fmi2Slave):
                 "block": self.block.get_state() if self.block.started else None,
                 "parameters": dict(self.block.parameters),
                 "integrator": self.block.integrator, "initial_state": self.block.initial_state,
-                "energy_balance": self.block.energy_balance,
+                "energy_balance": self.block.energy_balance, "scene": dict(self.block.scene),
                 "start_time": self.start_time, "plate_input": dict(self.plate_input),
                 "input_changed": self._input_changed,
             }
@@ -184,7 +190,7 @@ class BlockSlave(Fmi2Slave):
     def _set_fmu_state(self, state):
         try:
             block = Block(self.model, state["integrator"], state["initial_state"], state["energy_balance"],
-                          **state["parameters"])
+                          **state["parameters"], **state.get("scene", {}))
             if state["block"] is not None:
                 block.set_state(state["block"])
             self.start_time = float(state["start_time"])

@@ -26,20 +26,40 @@ began.  First order, one force evaluation per step.
 ``rk4`` (id 1) -- classical fourth-order Runge-Kutta on (x, z, vx, vz, F, phi) with the
 contact gate Theta(delta) evaluated inside each stage; the reset rule is applied after
 the step.  Fourth order between events, first order across a contact switch or reset.
+
+``event_driven`` (id 2, model A only; ``event_driven.py``) -- exact: between events model
+A is linear, so flight, contact and the loaded friction spring are integrated in closed
+form, and contact, detachment and Coulomb resets are located as first zeros of
+closed-form signals to EVENT_TOL (1e-12 tau_0).  It meets the contract with dt only
+defining the storage grid: n steps reach t0 + (n0 + n) dt directly at a cost set by the
+number of events, not of steps; phi and the energy terms are integrated exactly, so
+the energy residual stays at rounding level; splitting a run changes results only at
+the event tolerance, not bit for bit.
+
+``implicit_contact`` (id 3, ``implicit_contact.py``) -- stiff-stable: the linear normal and
+tangential spring-dashpots are integrated in closed form over the step, contact switches
+located inside it, the soft forces (drive spring, load, plate acceleration, turning of
+the frame on a corrugated plate) held at their midpoint values.  Second order for smooth
+motion, stable for any contact stiffness or damping; the drive spring stays explicit.
 """
 import math
 
 from numba import njit
 
 from .dynamics import contact, energy_rates, force, friction_rule, plate_motion
+from .event_driven import advance_event_driven
 from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z,
                      D_OMEGA, D_PHASE, D_T0, P_KT, P_M, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ,
                      Y_WORK, Y_X, Y_Z)
 
 SYMPLECTIC_EULER, RK4 = 0, 1
-INTEGRATORS = {"symplectic_euler": SYMPLECTIC_EULER, "rk4": RK4}
+EVENT_DRIVEN = 2
+IMPLICIT_CONTACT = 3  # implicit_contact.py: contact spring-dashpots in closed form, stiff-stable
+INTEGRATORS = {"symplectic_euler": SYMPLECTIC_EULER, "rk4": RK4, "event_driven": EVENT_DRIVEN,
+               "implicit_contact": IMPLICIT_CONTACT}
 # Evaluations of the forces per internal step: the cost unit of a scheme.
-FORCE_EVALUATIONS = {"symplectic_euler": 1, "rk4": 4}
+FORCE_EVALUATIONS = {"symplectic_euler": 1, "rk4": 4, "event_driven": 0,  # event_driven: cost per event, not per step
+                     "implicit_contact": 2}  # one soft-force evaluation + closed-form contact flows
 
 # The drive's sine and cosine advance by a rotation each step (a sin/cos pair costs more
 # than a whole model-A step) and are recomputed exactly every RESYNC steps, counted from
@@ -85,6 +105,10 @@ def advance(kind, method, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by n_steps internal steps with the chosen integrator (see module doc)."""
     if method == RK4:
         return _advance_rk4(kind, y, cnt, drv, prm, n_steps, track_energy)
+    if method == EVENT_DRIVEN:
+        return advance_event_driven(y, cnt, drv, prm, n_steps, track_energy)
+    if method == IMPLICIT_CONTACT:
+        return advance_implicit_contact(kind, y, cnt, drv, prm, n_steps, track_energy)
     return _advance_euler(kind, y, cnt, drv, prm, n_steps, track_energy)
 
 
@@ -294,6 +318,10 @@ def observe(kind, method, y, cnt, drv, prm, h, track_energy):
             x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(
                 kind, prm, x, z, vx, vz, shear, t, h, plate_z, plate_v, pzh, pvh, pz1, pv1, track_energy)
             state_contact = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        elif method == IMPLICIT_CONTACT:
+            x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = implicit_contact_scratch(
+                kind, prm, x, z, vx, vz, shear, t, h, plate_z, plate_v, pz1, pv1, track_energy)
+            state_contact = contact(kind, x, z, vx, vz, pz1, pv1, prm)
         else:
             x, z, vx, vz, shear, state_contact, d_phi, d_work, d_dissipated, d_normal = euler_step(
                 kind, prm, x, z, vx, vz, shear, t, h, h / prm[P_M], state_contact, plate_v, pz1, pv1,
@@ -309,3 +337,7 @@ def observe(kind, method, y, cnt, drv, prm, h, track_energy):
         t += h
     pen, u_n, u_t, cos_a, sin_a, normal = state_contact
     return x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, work, dissipated, e_normal, t
+
+
+# Imported last: implicit_contact builds on this module's drive helpers (drive_sin_cos, ...).
+from .implicit_contact import advance_implicit_contact, implicit_contact_scratch  # noqa: E402

@@ -1,0 +1,288 @@
+"""Scene reductions: run only the physics a scene needs.
+
+Three options drop parts of the full model (each is a Boolean FMU parameter, see
+``parameters.SCENE_OPTIONS``); this module is the compiled kernel that runs a block
+with any of them, one step at a time on the usual grid (the contract in ``stepping``).
+
+``rigid_contact`` (models A, B, C)
+    The block cannot penetrate the plate: while attached it rides the surface and the
+    normal force is whatever keeps it there; it leaves when that force would have to
+    pull (N < 0), flies, and lands with restitution 0 (the normal relative velocity is
+    removed, its kinetic energy dissipated).  Drops the contact oscillator (k_n,
+    gamma_n): no contact ringing, no dt limit from k_n.  The detachment threshold
+    becomes max plate acceleration = load / m (A = g / omega^2), the paper's line,
+    instead of the compliant A_c(omega).
+``frozen_vertical`` (model A)
+    The vertical motion is not integrated: the block sits on the steady in-contact
+    orbit of the harmonic drive (``block.steady_orbit``), pressed in quasi-statically by
+    an external plate acceleration.  Exact for model A on that orbit (vertical and
+    horizontal motions couple only through N).  A guard watches the orbit's
+    penetration: when it would reach 0, which happens from A = A_c(omega) (not from
+    A omega^2 = g: near resonance A_c is far lower), the kernel stops and the block
+    continues with the full model from the same state.
+``coulomb_friction`` (models A, B, C)
+    Plain Coulomb friction instead of the Cundall-Strack spring: stuck (no relative
+    tangential motion) while the needed force stays below mu_s N, else sliding against
+    mu_s N.  Drops k_t and the history variable F.  Note the paper's static and kinetic
+    coefficients are equal here, so the spring's reset - the source of the paper's
+    stick-slip - has no counterpart: see docs/scene_reductions.md for what it changes.
+
+Scheme: the paper's semi-implicit Euler step, with the rigid contact and the Coulomb
+stick treated at velocity level (Moreau's time-stepping): the normal impulse is the one
+that cancels the inward normal velocity, the friction force the one that stops the
+tangential relative motion, clipped to +- mu_s N.  First order.
+"""
+import math
+
+from numba import njit
+
+from .dynamics import contact, friction_rule, plate_motion
+from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
+                     D_PHASE, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F,
+                     Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+from .models import load, profile
+from .stepping import (FINITE_CHECK, RESYNC, drive_phase, drive_sin_cos, is_finite_state, kahan_add,
+                       plate_at_time)
+
+RIGID, FROZEN, COULOMB = 1, 2, 4
+# A rigidly attached block sits exactly on the surface; the plate's height recomputed at
+# an output time (exact sin/cos instead of the step's recurrence) may differ in the last
+# bits.  Penetrations down to -ATTACHED_TOLERANCE (1 + |z|) still count as attached: any
+# real flight leaves the surface by far more within its first step.
+ATTACHED_TOLERANCE = 1e-12
+
+
+@njit(cache=True)
+def orbit_response(prm, amplitude, omega):
+    """Complex amplitude R of the steady orbit y = z - Z_p = -W/k_n + Im(R e^{i theta}) of
+    m y'' + gamma_n y' + k_n y = -W + m A omega^2 sin(theta) (model A, W = m g)."""
+    m, k_n, g_n = prm[P_M], prm[P_KN], prm[P_GN]
+    response = m * amplitude * omega * omega / complex(k_n - m * omega * omega, g_n * omega)
+    return response.real, response.imag
+
+
+@njit(inline="always")
+def frozen_penetration(prm, omega, r_re, r_im, s, c, ext_a):
+    """Penetration and relative normal velocity u_n on the frozen vertical motion at the
+    drive phase (sin s, cos c), with the external acceleration pressing quasi-statically."""
+    m = prm[P_M]
+    rot_re, rot_im = r_re * c - r_im * s, r_re * s + r_im * c
+    return (m * (prm[P_G] + ext_a)) / prm[P_KN] - rot_im, omega * rot_re
+
+
+@njit(cache=True)
+def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, frozen_pen1, frozen_un1,
+               track_energy):
+    """One reduced step of length h.  Returns (x, z, vx, vz, F, engaged, N, T, d_phi, d_work,
+    d_dissipated, d_normal): the new state, whether the block is in contact at its end,
+    the normal force and the Coulomb friction force of the step (for the friction rule
+    and the outputs), and the increments of the quadratures."""
+    m = prm[P_M]
+    rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
+    pen, u_n, u_t, c, s, normal = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    plate_accel = (pv1 - pv0) / h
+    engaged = pen > 0.0 or (rigid and pen >= -ATTACHED_TOLERANCE * (1.0 + abs(z))) or frozen
+    # Forces other than the contact's normal force and the Coulomb friction.
+    drive = -prm[P_KD] * (x - prm[P_VD] * t)
+    load_x, load_z = load(kind, c, s, prm)
+    tangential = -prm[P_GT] * u_t
+    if engaged and not coulomb:
+        tangential -= prm[P_KT] * shear
+    fx = drive + load_x + tangential * c
+    fz = load_z + tangential * s
+    if rigid:
+        # The impulse that cancels the inward normal velocity relative to the plate's
+        # velocity at the step end; none if the block would leave by itself.
+        un_free = u_n + h / m * (-fx * s + fz * c) - plate_accel * h * c
+        normal = -m * un_free / h if (engaged and un_free < 0.0) else 0.0
+        engaged = normal > 0.0
+    friction = 0.0
+    stuck = False
+    if coulomb and engaged and normal > 0.0:
+        ut_free = u_t + h / m * (fx * c + fz * s) - plate_accel * h * s
+        bound = prm[P_MUS] * normal
+        friction = min(max(-m * ut_free / h, -bound), bound)
+        stuck = abs(m * ut_free / h) <= bound
+    fx += -normal * s + friction * c
+    fz += normal * c + friction * s
+    vx1 = vx + h / m * fx
+    vz1 = vz + h / m * fz
+    if stuck:  # no relative tangential motion at all, not a rounding residue of it
+        slip = vx1 * c + (vz1 - pv1) * s
+        vx1 -= slip * c
+        vz1 -= slip * s
+    x1 = x + h * vx1
+    z1 = z + h * vz1
+    height1, slope1 = profile(kind, x1, prm)
+    if slope1 == 0.0:
+        c1, s1 = 1.0, 0.0
+    else:
+        c1 = 1.0 / math.sqrt(1.0 + slope1 * slope1)
+        s1 = slope1 * c1
+    if frozen:  # model A: the prescribed vertical motion
+        z1, vz1 = pz1 + height1 - frozen_pen1, pv1 + frozen_un1
+    impact = impact_work = 0.0
+    engaged_end = engaged
+    if rigid:
+        landed = (pz1 + height1 - z1) * c1 > 0.0
+        if engaged or landed:
+            engaged_end = True
+            z1 = pz1 + height1  # on the surface
+            un1 = (vz1 - pv1) * c1 - vx1 * s1
+            if un1 < 0.0:  # restitution 0: the inward normal velocity is lost
+                vx1 += un1 * s1
+                vz1 -= un1 * c1
+                impact = 0.5 * m * un1 * un1
+                impact_work = -m * un1 * c1 * pv1  # the moving plate's share of the impulse's work
+    elif not frozen:
+        engaged_end = (pz1 + height1 - z1) > 0.0
+    if engaged and not coulomb:
+        shear += h * (vx1 * c1 + (vz1 - pv1) * s1)  # dF = u_t dt at the new velocity
+    d_work = d_dissipated = d_normal = 0.0
+    if track_energy:
+        # The plate's work: forces through its velocity at the step's start (as the paper's
+        # scheme), but constraint impulses (rigid N, Coulomb stick) bring the block to the
+        # plate's velocity at the step's end, so they work through the mean velocity.
+        constraint_v = 0.5 * (pv0 + pv1)
+        normal_v = constraint_v if rigid else pv0
+        d_work = (prm[P_KD] * (prm[P_VD] * t - x) * prm[P_VD] * h
+                  + (normal_v * normal * c + (pv0 * tangential + constraint_v * friction) * s) * h
+                  + load_x * (x1 - x) + load_z * (z1 - z) + impact_work)
+        d_dissipated = prm[P_GT] * u_t * u_t * h + impact
+        if coulomb:
+            d_dissipated -= friction * (vx1 * c1 + (vz1 - pv1) * s1) * h
+        if not rigid and pen > 0.0:
+            d_dissipated += prm[P_GN] * u_n * u_n * h
+            d_normal = -prm[P_KN] * pen * u_n * h
+    dv = vx1 - prm[P_VD]
+    return x1, z1, vx1, vz1, shear, engaged_end, normal, friction, h * dv * dv, d_work, d_dissipated, d_normal
+
+
+@njit(inline="always")
+def _plate(drv, s, c, t):
+    return plate_motion(drv[D_AMP], drv[D_OMEGA], s, c, drv[D_EXT_Z], drv[D_EXT_V], drv[D_EXT_A],
+                        t - drv[D_EXT_T])
+
+
+@njit(inline="always")
+def _end_normal(kind, rigid, x, z, vx, vz, pz, pv, step_normal, prm):
+    """The normal force the friction rule sees at a step's end: the step's constraint
+    force for a rigid contact, the spring-dashpot's at the new state otherwise."""
+    if rigid:
+        return step_normal
+    return contact(kind, x, z, vx, vz, pz, pv, prm)[5]
+
+
+@njit(cache=True)
+def advance_scene(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
+    """Advance by up to n_steps reduced steps.  Returns (steps taken, released): with
+    FROZEN the kernel stops before a step at whose end the frozen orbit would lose
+    contact (released = True; the caller continues with the full model).  Steps taken
+    is -1 if the state stopped being finite (arrays left as on entry)."""
+    t0, dt = drv[D_T0], drv[D_DT]
+    half_kt = 0.5 * prm[P_KT]
+    rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
+    r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
+    n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
+    rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
+    s, c = drive_sin_cos(drv, cnt, n)
+    t = t0 + n * dt
+    pz0, pv0 = _plate(drv, s, c, t)
+    done = 0
+    released = False
+    while done < n_steps:
+        n1 = n + 1
+        if ((n1 - anchor) & (RESYNC - 1)) == 0:
+            phase = drive_phase(drv, cnt, n1)
+            s1, c1 = math.sin(phase), math.cos(phase)
+        else:
+            s1, c1 = s * rot_c + c * rot_s, c * rot_c - s * rot_s
+        t_new = t0 + n1 * dt
+        pz1, pv1 = _plate(drv, s1, c1, t_new)
+        pen_f, un_f = 0.0, 0.0
+        if frozen:
+            pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, s1, c1, drv[D_EXT_A])
+            if pen_f <= 0.0:  # the guard: the block would detach here, hand over
+                released = True
+                break
+        x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
+            kind, flags, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz1, pv1, pen_f, un_f, track_energy)
+        loaded = shear
+        if coulomb:
+            shear = 0.0
+        else:
+            end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
+            shear, reset = friction_rule(shear, 1.0 if engaged else 0.0, end_normal, prm)
+            slips += reset
+        phi, phi_c = kahan_add(phi, phi_c, d_phi)
+        if track_energy:
+            work += d_work
+            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
+            e_normal += d_normal
+        n, s, c, t, pz0, pv0 = n1, s1, c1, t_new, pz1, pv1
+        done += 1
+        if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
+            return -1, False
+    if not is_finite_state(x, z, vx, vz, shear):
+        return -1, False
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
+    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
+    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    return done, released
+
+
+@njit(cache=True)
+def observe_scene(kind, flags, y, cnt, drv, prm, h, track_energy):
+    """``stepping.observe`` for a reduced block, plus the Coulomb friction force: the
+    state at t_n + h (one scratch step from the grid state), and the normal and friction
+    forces acting there (those of a step of dt starting at that state)."""
+    dt = drv[D_DT]
+    rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
+    r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
+    t = drv[D_T0] + cnt[C_STEP] * dt
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, slips = y[Y_PHI], cnt[C_SLIPS]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
+    # At the grid point, the plate exactly as the kernel saw it (its sin/cos recurrence):
+    # a rigidly attached block then sits on the surface to the last bit.
+    s0, c0 = drive_sin_cos(drv, cnt, cnt[C_STEP])
+    pz0, pv0 = _plate(drv, s0, c0, t)
+    anchor_time = drv[D_T0] + cnt[C_PHASE_STEP] * dt
+    if h > 0.0:
+        pz1, pv1 = plate_at_time(drv, cnt, prm, t + h)
+        phase = drv[D_PHASE] + drv[D_OMEGA] * (t + h - anchor_time)
+        pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase),
+                                         drv[D_EXT_A])
+        x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
+            kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, pen_f, un_f, track_energy)
+        loaded = shear
+        if coulomb:
+            shear = 0.0
+        else:
+            end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
+            shear, reset = friction_rule(shear, 1.0 if engaged else 0.0, end_normal, prm)
+            slips += reset
+        phi += d_phi
+        if track_energy:
+            work += d_work
+            dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+            e_normal += d_normal
+        t += h
+        pz0, pv0 = pz1, pv1
+    # The forces acting at the reported state: those of a step of dt starting there.
+    pz2, pv2 = plate_at_time(drv, cnt, prm, t + dt)
+    phase = drv[D_PHASE] + drv[D_OMEGA] * (t + dt - anchor_time)
+    pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase), drv[D_EXT_A])
+    probe = scene_step(kind, flags, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz2, pv2, pen_f, un_f, False)
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    in_contact = pen > 0.0
+    if rigid:
+        normal = probe[6]
+        in_contact = pen >= -ATTACHED_TOLERANCE * (1.0 + abs(z)) and normal > 0.0
+    friction = probe[7] if coulomb else (-prm[P_KT] * shear if in_contact else 0.0)
+    return (x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, work, dissipated, e_normal, t,
+            in_contact, friction)
