@@ -16,7 +16,7 @@ from . import layout as L
 from .models import MODELS, load, profile
 from .parameters import INITIAL_STATES, SCENE_OPTIONS, parameters_for
 from .event_driven import observe_event_driven
-from .stepping import FORCE_EVALUATIONS, INTEGRATORS, RK4, advance, observe
+from .stepping import FORCE_EVALUATIONS, INTEGRATORS, advance, observe
 from .scenes import COULOMB, FROZEN, RIGID, advance_scene, observe_scene
 from .implicit_contact import (MAX_PIECES, MAX_SEGMENTS, MAX_TURN_PER_STEP, TOO_FAST_FOR_CORRUGATION,
                                TOO_MANY_SWITCHES)

@@ -79,12 +79,13 @@ import math
 import numpy as np
 from numba import njit
 
-from .dynamics import contact, friction_rule, plate_motion
+from .dynamics import contact, plate_motion
 from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z,
                      D_OMEGA, D_T0, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F,
                      Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .models import load, profile
-from .stepping import FINITE_CHECK, RESYNC, drive_phase, drive_sin_cos, is_finite_state, kahan_add
+from .stepping import (FINITE_CHECK, RESYNC, drive_phase, drive_sin_cos, is_finite_state,
+                       settle_step, store_state)
 
 TOO_MANY_SWITCHES = -2
 TOO_FAST_FOR_CORRUGATION = -3
@@ -523,7 +524,6 @@ def advance_implicit_contact(kind, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by n_steps steps (the contract in ``stepping``); returns the steps taken or a
     negative status, leaving the arrays as they were on entry."""
     t0, dt = drv[D_T0], drv[D_DT]
-    half_kt = 0.5 * prm[P_KT]
     table = step_propagators(prm, dt)
     seg_len = np.empty(MAX_SEGMENTS)
     seg_contact = np.empty(MAX_SEGMENTS, dtype=np.bool_)
@@ -552,23 +552,15 @@ def advance_implicit_contact(kind, y, cnt, drv, prm, n_steps, track_energy):
         if status < 0:
             return status
         pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-        loaded = shear
-        shear, reset = friction_rule(shear, pen, normal, prm)
-        slips += reset
-        phi, phi_c = kahan_add(phi, phi_c, d_phi)
-        if track_energy:
-            work += d_work
-            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
-            e_normal += d_normal
+        shear, slips, phi, phi_c, work, dissipated, e_normal = settle_step(
+            prm, shear, pen, normal, slips, phi, phi_c, work, dissipated, e_normal,
+            d_phi, d_work, d_dissipated, d_normal, track_energy)
         t, pz0, pv0 = t_new, pz1, pv1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
     if not is_finite_state(x, z, vx, vz, shear):
         return -1
-    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
-    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
-    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
-    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    store_state(y, cnt, x, z, vx, vz, shear, phi, phi_c, work, dissipated, e_normal, n, slips)
     return done
 
 

@@ -241,7 +241,7 @@ def observe_scene(kind, flags, y, cnt, drv, prm, h, track_energy):
     state at t_n + h (one scratch step from the grid state), and the normal and friction
     forces acting there (those of a step of dt starting at that state)."""
     dt = drv[D_DT]
-    rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
+    rigid, coulomb = (flags & RIGID) != 0, (flags & COULOMB) != 0
     r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
     t = drv[D_T0] + cnt[C_STEP] * dt
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]

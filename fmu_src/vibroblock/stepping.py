@@ -100,6 +100,29 @@ def is_finite_state(x, z, vx, vz, shear):
     return math.isfinite(x + z + vx + vz + shear)
 
 
+@njit(inline="always")
+def settle_step(prm, shear, penetration, normal, slips, phi, phi_c, work, dissipated, e_normal,
+                d_phi, d_work, d_dissipated, d_normal, track_energy):
+    """End of every step of every scheme: the friction rule at the new state (a reset
+    releases k_t F^2/2, counted as dissipated), then the step's quadratures."""
+    loaded = shear
+    shear, reset = friction_rule(shear, penetration, normal, prm)
+    phi, phi_c = kahan_add(phi, phi_c, d_phi)
+    if track_energy:
+        work += d_work
+        dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+        e_normal += d_normal
+    return shear, slips + reset, phi, phi_c, work, dissipated, e_normal
+
+
+@njit(inline="always")
+def store_state(y, cnt, x, z, vx, vz, shear, phi, phi_c, work, dissipated, e_normal, n, slips):
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
+    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
+    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+
+
 @njit(cache=True)
 def advance(kind, method, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by n_steps internal steps with the chosen integrator (see module doc)."""
@@ -146,7 +169,6 @@ def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plat
 def _advance_euler(kind, y, cnt, drv, prm, n_steps, track_energy):
     t0, dt = drv[D_T0], drv[D_DT]
     dt_m = dt / prm[P_M]
-    half_kt = 0.5 * prm[P_KT]
     # A plate at rest (no drive, no input) needs no kinematics in the loop.
     plate_moves = drv[D_AMP] != 0.0 or drv[D_EXT_V] != 0.0 or drv[D_EXT_A] != 0.0
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
@@ -175,23 +197,15 @@ def _advance_euler(kind, y, cnt, drv, prm, n_steps, track_energy):
             pz1, pv1 = plate_z, plate_v
         x, z, vx, vz, shear, state_contact, d_phi, d_work, d_dissipated, d_normal = euler_step(
             kind, prm, x, z, vx, vz, shear, t, dt, dt_m, state_contact, plate_v, pz1, pv1, track_energy)
-        loaded = shear
-        shear, reset = friction_rule(shear, state_contact[0], state_contact[5], prm)
-        slips += reset
-        phi, phi_c = kahan_add(phi, phi_c, d_phi)
-        if track_energy:
-            work += d_work
-            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
-            e_normal += d_normal
+        shear, slips, phi, phi_c, work, dissipated, e_normal = settle_step(
+            prm, shear, state_contact[0], state_contact[5], slips, phi, phi_c, work, dissipated, e_normal,
+            d_phi, d_work, d_dissipated, d_normal, track_energy)
         t, plate_z, plate_v = t_new, pz1, pv1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
     if not is_finite_state(x, z, vx, vz, shear):
         return -1
-    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
-    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
-    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
-    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    store_state(y, cnt, x, z, vx, vz, shear, phi, phi_c, work, dissipated, e_normal, n, slips)
     return done
 
 
@@ -243,7 +257,6 @@ def _advance_rk4(kind, y, cnt, drv, prm, n_steps, track_energy):
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, phi_c = y[Y_PHI], y[Y_PHI_C]
     work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
-    half_kt = 0.5 * prm[P_KT]
     n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
     rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
     half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
@@ -266,23 +279,15 @@ def _advance_rk4(kind, y, cnt, drv, prm, n_steps, track_energy):
         x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(
             kind, prm, x, z, vx, vz, shear, t, t_new - t, pz0, pv0, pz_half, pv_half, pz1, pv1, track_energy)
         pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-        loaded = shear
-        shear, reset = friction_rule(shear, pen, normal, prm)
-        slips += reset
-        phi, phi_c = kahan_add(phi, phi_c, d_phi)
-        if track_energy:
-            work += d_work
-            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
-            e_normal += d_normal
+        shear, slips, phi, phi_c, work, dissipated, e_normal = settle_step(
+            prm, shear, pen, normal, slips, phi, phi_c, work, dissipated, e_normal,
+            d_phi, d_work, d_dissipated, d_normal, track_energy)
         t, pz0, pv0 = t_new, pz1, pv1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return -1
     if not is_finite_state(x, z, vx, vz, shear):
         return -1
-    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
-    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
-    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
-    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    store_state(y, cnt, x, z, vx, vz, shear, phi, phi_c, work, dissipated, e_normal, n, slips)
     return done
 
 
