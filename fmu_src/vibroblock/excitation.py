@@ -66,6 +66,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .parameters import NON_NEGATIVE, POSITIVE, Parameter
+
 MODES = {0: "harmonic", 1: "linear_chirp", 2: "log_chirp", 3: "harmonic_sum", 4: "playback"}
 HARMONIC, LINEAR_CHIRP, LOG_CHIRP, HARMONIC_SUM, PLAYBACK = range(5)
 N_COMPONENTS = 4
@@ -92,32 +94,7 @@ class ExcitationError(ValueError):
 
 
 # ---------------------------------------------------------------------------- parameters
-FINITE, POSITIVE, NON_NEGATIVE = "finite", "positive", "non-negative"
-_RULES = {
-    FINITE: (lambda v: True, "a finite number"),
-    POSITIVE: (lambda v: v > 0.0, "a finite number > 0"),
-    NON_NEGATIVE: (lambda v: v >= 0.0, "a finite number >= 0"),
-}
-
-
-@dataclass(frozen=True)
-class Parameter:
-    name: str
-    default: float
-    unit: str
-    description: str
-    constraint: str = FINITE
-
-    def problem(self, value) -> str | None:
-        """Why ``value`` is not admissible for this parameter, or None."""
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            return f"{self.name} = {value!r} is not a number"
-        ok, wanted = _RULES[self.constraint]
-        if not math.isfinite(v) or not ok(v):
-            return f"{self.name} = {v!r} is not admissible: it must be {wanted} ({self.description})"
-        return None
+# The same admissibility rules as the block's parameters (parameters.py).
 
 
 def _component_parameters():
