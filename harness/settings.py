@@ -26,7 +26,8 @@ PRESETS: dict[str, dict[str, float]] = {
     "scaled": {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3},
 }
 
-INTEGRATORS = {"symplectic_euler": 0, "rk4": 1}
+# The FMUs' `integrator` ids (vibroblock.INTEGRATORS; the harness does not import the core).
+INTEGRATORS = {"symplectic_euler": 0, "rk4": 1, "event_driven": 2, "implicit_contact": 3}
 INITIAL_STATES = {"equilibrium": 0, "given": 1, "steady_orbit": 2}
 
 # FMU parameters owned by a settings object other than ``RunSettings.parameters``:

@@ -139,3 +139,16 @@ def test_an_fmu_with_another_core_in_the_same_process_is_refused_cleanly(fmu_a, 
     assert done.returncode == 0, done.stderr[-2000:]
     assert "refused: fmi2Instantiate failed (error)" in done.stdout and "different vibroblock core" in done.stdout
     assert done.stdout.strip().endswith("process still alive")
+
+
+def test_the_harness_knows_every_integrator_the_fmus_offer(fmu_path):
+    """The harness does not import the core; its integrator ids must match the FMU's."""
+    import re
+
+    from fmpy import read_model_description
+
+    from harness.settings import INTEGRATORS
+
+    variable = next(v for v in read_model_description(fmu_path("A")).modelVariables if v.name == "integrator")
+    offered = {name: int(i) for i, name in re.findall(r"(\d+) = (\w+)", variable.description)}
+    assert offered == INTEGRATORS
