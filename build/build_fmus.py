@@ -1,8 +1,10 @@
 """Build the vibroblock FMUs: ``python build/build_fmus.py [--dest build/fmus] [NAME ...]``.
 
-Each ``fmu_src/<Name>.py`` facade script becomes ``<dest>/<Name>.fmu`` (FMI 2.0
-co-simulation) with the physics core ``fmu_src/vibroblock`` bundled as pythonfmu
-project files.  After pythonfmu has written the archive, finishing steps make it a
+One FMU per registered model variant (``vibroblock.models``: ``Block<Name>.fmu``, its
+facade script generated here) and one per FMU script in ``fmu_src`` (``Excitation``),
+FMI 2.0 co-simulation, with the physics core ``fmu_src/vibroblock`` bundled as pythonfmu
+project files.  ``--list`` prints the names; ``--sources`` builds from another source
+tree (e.g. a copy with one more variant).  After pythonfmu has written the archive, finishing steps make it a
 complete, reproducible FMI 2.0 FMU:
 
 * the native status shim is installed in front of pythonfmu's library, so that a
@@ -27,10 +29,37 @@ SOURCES = ROOT / "fmu_src"
 CORE = SOURCES / "vibroblock"
 DEFAULT_DEST = ROOT / "build" / "fmus"
 FIXED_TIMESTAMP = (1980, 1, 1, 0, 0, 0)  # the earliest a zip archive can record
-FMU_NAMES = ("BlockA", "BlockB", "BlockC", "Excitation")
+BLOCK_SCRIPT = '''"""FMU: {description} (vibroblock, a spring-block on a vibrating plate)."""
+from pythonfmu import Fmi2Slave
+
+from vibroblock.slave import block_fmu
+
+
+@block_fmu("{model}")
+class Block{model}(Fmi2Slave):
+    """{description}. Forces and geometry: vibroblock/models/model_{module}.py."""
+'''
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.insert(0, str(SOURCES))
+
+
+def use_sources(sources: Path = SOURCES) -> None:
+    """Import the core from ``sources`` (the build's process imports nothing else of it)."""
+    global SOURCES, CORE
+    SOURCES, CORE = Path(sources).resolve(), Path(sources).resolve() / "vibroblock"
+    sys.path.insert(0, str(SOURCES))
+
+
+def variant_scripts() -> dict[str, str]:
+    """FMU name -> facade script of every registered variant."""
+    from vibroblock.models import VARIANTS
+    return {v.fmu_name: BLOCK_SCRIPT.format(model=v.name, module=v.name.lower(), description=v.description)
+            for v in VARIANTS.values()}
+
+
+def fmu_names() -> list[str]:
+    scripts = sorted(p.stem for p in SOURCES.glob("*.py"))
+    return list(variant_scripts()) + scripts
 
 
 def complete_model_description(xml_text: bytes) -> bytes:
@@ -87,9 +116,16 @@ def finish_archive(fmu: Path) -> None:
 def build(name: str, dest: Path) -> Path:
     from pythonfmu.builder import FmuBuilder
 
-    script = SOURCES / f"{name}.py"
-    fmu = FmuBuilder.build_FMU(script, dest=dest, project_files=[CORE],
-                               canGetAndSetFMUstate=True, canSerializeFMUstate=True)
+    generated = variant_scripts()
+    with tempfile.TemporaryDirectory() as scratch:
+        script = SOURCES / f"{name}.py"
+        if name in generated:
+            script = Path(scratch) / f"{name}.py"
+            script.write_text(generated[name])
+        elif not script.is_file():
+            raise SystemExit(f"no FMU named {name!r}; the FMUs are {fmu_names()}")
+        fmu = FmuBuilder.build_FMU(script, dest=dest, project_files=[CORE],
+                                   canGetAndSetFMUstate=True, canSerializeFMUstate=True)
     fmu = Path(fmu)
     from status_shim import wrap_fmu
     wrap_fmu(fmu)
@@ -99,11 +135,17 @@ def build(name: str, dest: Path) -> Path:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("names", nargs="*", default=list(FMU_NAMES), help="FMUs to build (default: all)")
+    parser.add_argument("names", nargs="*", help="FMUs to build (default: all)")
     parser.add_argument("--dest", type=Path, default=DEFAULT_DEST, help="output folder")
+    parser.add_argument("--sources", type=Path, default=SOURCES, help="source tree (fmu_src)")
+    parser.add_argument("--list", action="store_true", help="print the FMU names and stop")
     args = parser.parse_args(argv)
+    use_sources(args.sources)
+    if args.list:
+        print(" ".join(fmu_names()))
+        return 0
     args.dest.mkdir(parents=True, exist_ok=True)
-    for name in args.names:
+    for name in args.names or fmu_names():
         print(f"built {build(name, args.dest)}")
     return 0
 

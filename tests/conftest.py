@@ -20,7 +20,7 @@ def fmu_dir(tmp_path_factory):
     import build_fmus
 
     dest = tmp_path_factory.mktemp("fmus")
-    for name in build_fmus.FMU_NAMES:
+    for name in build_fmus.fmu_names():
         build_fmus.build(name, dest)
     return dest
 

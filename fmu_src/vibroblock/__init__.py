@@ -1,24 +1,31 @@
 """vibroblock: a spring-block on a vibrating plate (Giacco, Lippiello, Pica Ciamarra).
 
-The physics core bundled into the FMUs and used by the harness.
+The physics core bundled into the FMUs and used by the harness.  Importing the package
+(or ``vibroblock.orbits``, ``vibroblock.parameters``) loads no compiler and changes no
+setting; the names below are loaded on first use.
 """
-import os as _os
+from __future__ import annotations
 
-# Compiled kernels are cached on disk; an FMU is often extracted to a fresh folder, so
-# unless the host chose a cache folder, use a stable per-user one (numba reads the
-# setting when it is first imported, which happens just below).
-_os.environ.setdefault("NUMBA_CACHE_DIR", _os.path.join(
-    _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache"), "vibroblock", "numba"))
+import importlib
 
-from . import jitcache  # noqa: E402
+# name -> module that defines it, imported on first access (PEP 562)
+_LAZY = {
+    "Block": "block", "ModelError": "settings", "OUTPUTS": "interface",
+    "MODELS": "models", "MODEL_DESCRIPTIONS": "models", "VARIANTS": "models", "parameters_for": "models",
+    "defaults": "models",
+    "INTEGRATORS": "integrators",
+    "INITIAL_STATES": "parameters", "PARAMETERS": "parameters",
+    "detachment_amplitude": "orbits", "friction_loss_amplitude": "orbits", "steady_orbit": "orbits",
+}
+_RENAMED = {"MODEL_DESCRIPTIONS": "DESCRIPTIONS", "PARAMETERS": "COMMON_PARAMETERS"}
 
-jitcache.install()
+__all__ = sorted(_LAZY)
 
-from .block import OUTPUTS, Block, ModelError, detachment_amplitude, steady_orbit  # noqa: E402
-from .models import DESCRIPTIONS as MODEL_DESCRIPTIONS  # noqa: E402
-from .models import MODELS  # noqa: E402
-from .parameters import INITIAL_STATES, PARAMETERS, defaults, parameters_for  # noqa: E402
-from .stepping import FORCE_EVALUATIONS, INTEGRATORS  # noqa: E402
 
-__all__ = ["Block", "ModelError", "OUTPUTS", "MODELS", "MODEL_DESCRIPTIONS", "INTEGRATORS", "FORCE_EVALUATIONS",
-           "INITIAL_STATES", "PARAMETERS", "defaults", "parameters_for", "detachment_amplitude", "steady_orbit"]
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'vibroblock' has no attribute {name!r}")
+    module = importlib.import_module(f".{_LAZY[name]}", __name__)
+    value = getattr(module, _RENAMED.get(name, name))
+    globals()[name] = value
+    return value

@@ -20,6 +20,7 @@ Heaviside factors gate on penetration only, and we follow them literally.
 """
 import math
 
+from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
 from .layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_MUS, P_VD

@@ -2,8 +2,9 @@
 
 The README's interface table is this module's output; a test keeps the two equal.
 """
-from .parameters import INITIAL_STATES, MODEL_DEFAULTS, PARAMETERS, SCENE_OPTIONS
-from .stepping import INTEGRATORS
+from .integrators import INTEGRATOR_RECORDS, INTEGRATORS
+from .models import VARIANTS, offered_by
+from .parameters import INITIAL_STATES, SCENE_OPTIONS
 
 INPUTS = {
     "plate_z": ("delta_0", "external plate height, added to the internal drive"),
@@ -37,24 +38,50 @@ ENERGY_BALANCE = "account work, dissipation and stored energy (outputs work_inpu
 INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
 
 
+def _models_column(names) -> str:
+    return "".join(names)
+
+
+def parameter_rows():
+    """Every parameter once, in the FMU order of the first variant that has it, with the
+    variants that have it and their defaults."""
+    rows = {}
+    for variant in VARIANTS.values():
+        for p in variant.parameters:
+            rows.setdefault(p.name, (p, {}))[1][variant.name] = p.default
+    return list(rows.values())
+
+
 def markdown_table() -> str:
     rows = ["| name | kind | models | unit | default | meaning |", "|---|---|---|---|---|---|"]
-    for p in PARAMETERS:
+    every = _models_column(sorted(VARIANTS))
+    for p, defaults in parameter_rows():
         kind = "parameter, tunable" if p.tunable else "parameter"
         default = f"{p.default:g}"
-        overridden = [m for m, values in MODEL_DEFAULTS.items() if p.name in values]
+        overridden = sorted(m for m, value in defaults.items() if value != p.default)
         if overridden:
-            default += f" ({', '.join(overridden)}: {MODEL_DEFAULTS[overridden[0]][p.name]:g})"
-        rows.append(f"| `{p.name}` | {kind} | {p.models} | {p.unit} | {default} | {p.description} |")
-    rows.append(f"| `integrator` | parameter (Integer) | ABC | | 0 | {INTEGRATOR_CHOICES} |")
-    rows.append(f"| `initial_state` | parameter (Integer) | ABC | | 0 | {INITIAL_CHOICES} |")
-    rows.append(f"| `energy_balance` | parameter (Boolean) | ABC | | false | {ENERGY_BALANCE} |")
+            default += f" ({', '.join(overridden)}: {defaults[overridden[0]]:g})"
+        rows.append(f"| `{p.name}` | {kind} | {_models_column(sorted(defaults))} | {p.unit} | {default} | "
+                    f"{p.description} |")
+    rows.append(f"| `integrator` | parameter (Integer) | {every} | | 0 | {INTEGRATOR_CHOICES} |")
+    rows.append(f"| `initial_state` | parameter (Integer) | {every} | | 0 | {INITIAL_CHOICES} |")
+    rows.append(f"| `energy_balance` | parameter (Boolean) | {every} | | false | {ENERGY_BALANCE} |")
     for name, (models, text) in SCENE_OPTIONS.items():
-        rows.append(f"| `{name}` | parameter (Boolean) | {models} | | false | {text} |")
+        rows.append(f"| `{name}` | parameter (Boolean) | {_models_column(offered_by(models))} | | false | {text} |")
     for name, (unit, text) in INPUTS.items():
-        rows.append(f"| `{name}` | input | ABC | {unit} | 0 | {text} |")
+        rows.append(f"| `{name}` | input | {every} | {unit} | 0 | {text} |")
     for name, (kind, unit, text) in OUTPUTS.items():
-        rows.append(f"| `{name}` | output ({kind}) | ABC | {unit} | | {text} |")
+        rows.append(f"| `{name}` | output ({kind}) | {every} | {unit} | | {text} |")
+    return "\n".join(rows)
+
+
+def integrator_table() -> str:
+    """The integrators as a markdown table (the README's), from the registry."""
+    rows = ["| id | name | models | force evaluations per step | what it is |", "|---|---|---|---|---|"]
+    for record in INTEGRATOR_RECORDS.values():
+        cost = str(record.force_evaluations) if record.force_evaluations else "per event"
+        rows.append(f"| {record.id} | `{record.name}` | {_models_column(offered_by(record.models))} | {cost} | "
+                    f"{record.summary} |")
     return "\n".join(rows)
 
 

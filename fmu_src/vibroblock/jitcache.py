@@ -10,9 +10,16 @@ functions from several files) invalidates it.
 from __future__ import annotations
 
 import hashlib
+import os
 from pathlib import Path
 
-from numba.core import caching, config
+# An FMU is often extracted to a fresh folder, so unless the host chose a cache folder,
+# use a stable per-user one.  numba reads the setting when it is first imported, just
+# below; every module with compiled kernels imports this one first.
+os.environ.setdefault("NUMBA_CACHE_DIR", os.path.join(
+    os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "vibroblock", "numba"))
+
+from numba.core import caching, config  # noqa: E402
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 
@@ -51,3 +58,6 @@ def install() -> None:
     locators = caching.CacheImpl._locator_classes
     if not any(cls.__name__ == CoreCacheLocator.__name__ and cls.__module__ == __name__ for cls in locators):
         locators.insert(0, CoreCacheLocator)
+
+
+install()

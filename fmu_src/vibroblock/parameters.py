@@ -2,9 +2,13 @@
 
 One table serves the FMU interface (variable names, start values, descriptions),
 the core's validation and the README's interface table, so the three cannot drift.
+A variant's own parameters and its defaults are declared in its module (``models``);
+``models.parameters_for`` assembles a variant's full list.  Importing this module
+loads nothing but the standard library.
 
 Units follow the paper (Sec. II C): m = g = k_n = 1, lengths in delta_0 = m g / k_n,
-times in tau_0 = sqrt(m / k_n).  All parameters are Real.
+times in tau_0 = sqrt(m / k_n).  Physical parameters are Real; the switches (integrator, initial state, scene options)
+are Integer or Boolean.
 """
 from __future__ import annotations
 
@@ -31,7 +35,6 @@ class Parameter:
     description: str
     constraint: str = FINITE
     tunable: bool = False
-    models: str = "ABC"  # the variants that have this parameter
 
     def problem(self, value) -> str | None:
         """Why ``value`` is not admissible for this parameter, or None."""
@@ -46,9 +49,12 @@ class Parameter:
 
 
 L, T = "delta_0", "tau_0"
-PARAMETERS: tuple[Parameter, ...] = (
+# Parameters every variant has, in the FMU's order; a variant's own parameters (its
+# surface and load, declared in its module under ``models``) come after ``VARIANT_AFTER``.
+# ``g`` is offered only by the variants that are confined by gravity (they list it).
+COMMON_PARAMETERS: tuple[Parameter, ...] = (
     Parameter("m", 1.0, "m_0", "block mass", POSITIVE),
-    Parameter("g", 1.0, f"{L}/{T}^2", "gravitational acceleration (models A, B)", NON_NEGATIVE, models="AB"),
+    Parameter("g", 1.0, f"{L}/{T}^2", "gravitational acceleration (models A, B)", NON_NEGATIVE),
     Parameter("k_n", 1.0, f"m_0/{T}^2", "normal contact stiffness", POSITIVE),
     Parameter("k_t", 0.28, f"m_0/{T}^2", "tangential (Cundall-Strack) contact stiffness", NON_NEGATIVE),
     Parameter("gamma_n", 0.07, f"m_0/{T}", "normal contact damping", NON_NEGATIVE),
@@ -58,34 +64,27 @@ PARAMETERS: tuple[Parameter, ...] = (
     Parameter("V_d", 2e-5, f"{L}/{T}", "drive velocity of the spring's far end", FINITE),
     Parameter("A", 0.0, L, "amplitude of the internal plate drive A sin(omega t)", FINITE, tunable=True),
     Parameter("omega", 0.0, f"1/{T}", "angular frequency of the internal plate drive", NON_NEGATIVE, tunable=True),
-    Parameter("A_x", 1e3, L, "corrugation amplitude: plate surface A_x sin(omega_x x)", NON_NEGATIVE, models="BC"),
-    Parameter("omega_x", 2e-2, f"1/{L}", "corrugation wave number", NON_NEGATIVE, models="BC"),
-    Parameter("P_l", 1.0, f"m_0 {L}/{T}^2", "confining force, normal to the plate surface", NON_NEGATIVE, models="C"),
     Parameter("dt", 4e-4, T, "internal integration step", POSITIVE),
     Parameter("x_start", 0.0, L, "initial horizontal position", FINITE),
     Parameter("z_start", 0.0, L, "initial height (used when initial_state = 1)", FINITE),
     Parameter("vx_start", 0.0, f"{L}/{T}", "initial horizontal velocity", FINITE),
     Parameter("vz_start", 0.0, f"{L}/{T}", "initial vertical velocity (initial_state 0 and 1)", FINITE),
 )
-
-# Model B of the paper (Sec. III B) uses another drive; C keeps B's corrugation.
-MODEL_DEFAULTS: dict[str, dict[str, float]] = {
-    "A": {},
-    "B": {"V_d": 2e-4, "k_d": 5e-6},
-    "C": {"V_d": 2e-4, "k_d": 5e-6},
-}
+ALL_VARIANTS = "*"  # a scene option or parameter every registered variant offers
+OPTIONAL_COMMON = ("g",)  # present only in the variants that list them in their PARAMETERS
+VARIANT_AFTER = "omega"
 
 # Scene reductions (``vibroblock.scenes``): physics a scene may drop.  Boolean
-# parameters, off by default; name -> (models, description).  One table for the FMU
+# parameters, off by default; name -> (variants that offer it, description).  One table for the FMU
 # variables, the core's validation and the README.
 SCENE_OPTIONS = {
-    "rigid_contact": ("ABC", "rigid instead of compliant normal contact: the block rides the surface until the "
+    "rigid_contact": (ALL_VARIANTS, "rigid instead of compliant normal contact: the block rides the surface until the "
                       "normal force would pull, then flies and lands with restitution 0 (drops k_n, gamma_n and "
                       "their dt limit; detachment at max plate acceleration = load/m)"),
     "frozen_vertical": ("A", "vertical motion frozen on the steady in-contact orbit of the drive (external plate "
                         "acceleration pressing quasi-statically); a guard hands over to the full model when that "
                         "orbit would lose contact (A >= A_c(omega))"),
-    "coulomb_friction": ("ABC", "plain Coulomb friction instead of the history-dependent spring: stuck while the "
+    "coulomb_friction": (ALL_VARIANTS, "plain Coulomb friction instead of the history-dependent spring: stuck while the "
                          "needed tangential force stays below mu_s N, else sliding against mu_s N (drops k_t, F)"),
 }
 
@@ -94,19 +93,3 @@ INITIAL_STATES = {
     1: "given: x_start, z_start, vx_start, vz_start as set",
     2: "steady_orbit: on the steady in-contact orbit of the harmonic drive (exact for model A)",
 }
-
-
-def parameters_for(model: str) -> tuple[Parameter, ...]:
-    """The parameters of one model variant, with that variant's defaults."""
-    overrides = MODEL_DEFAULTS[model]
-    out = []
-    for p in PARAMETERS:
-        if model in p.models:
-            if p.name in overrides:
-                p = Parameter(**{**p.__dict__, "default": overrides[p.name]})
-            out.append(p)
-    return tuple(out)
-
-
-def defaults(model: str) -> dict[str, float]:
-    return {p.name: p.default for p in parameters_for(model)}

@@ -1,8 +1,9 @@
 """Scene reductions: run only the physics a scene needs.
 
 Three options drop parts of the full model (each is a Boolean FMU parameter, see
-``parameters.SCENE_OPTIONS``); this module is the compiled kernel that runs a block
-with any of them, one step at a time on the usual grid (the contract in ``stepping``).
+``parameters.SCENE_OPTIONS``); this module is the step that runs a block with any of
+them, a scheme of the shared fixed-step driver (``integrators.fixed_step``) registered
+as ``reduced_scene``, on the usual grid and under the same contract.
 
 ``rigid_contact`` (models A, B, C)
     The block cannot penetrate the plate: while attached it rides the surface and the
@@ -14,7 +15,7 @@ with any of them, one step at a time on the usual grid (the contract in ``steppi
     instead of the compliant A_c(omega).
 ``frozen_vertical`` (model A)
     The vertical motion is not integrated: the block sits on the steady in-contact
-    orbit of the harmonic drive (``block.steady_orbit``), pressed in quasi-statically by
+    orbit of the harmonic drive (``orbits.steady_orbit``), pressed in quasi-statically by
     an external plate acceleration.  Exact for model A on that orbit (vertical and
     horizontal motions couple only through N).  A guard watches the orbit's
     penetration: when it would reach 0, which happens from A = A_c(omega) (not from
@@ -34,17 +35,21 @@ tangential relative motion, clipped to +- mu_s N.  First order.
 """
 import math
 
-from numba import njit
+from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import literally, njit
 
-from .dynamics import contact, friction_rule, plate_motion
-from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
-                     D_PHASE, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F,
-                     Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+from .dynamics import contact, friction_rule
+from .integrators.fixed_step import OK, STOP
+from .integrators.plate import drive_sin_cos, phase_at_time, plate_at, plate_at_time
+from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED,
+                     O_E_NORMAL, O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X,
+                     O_Z, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI,
+                     Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .models import load, profile
-from .stepping import (FINITE_CHECK, RESYNC, drive_phase, drive_sin_cos, is_finite_state, kahan_add,
-                       plate_at_time)
 
 RIGID, FROZEN, COULOMB = 1, 2, 4
+# The id of this scheme in the integrator registry (internal: chosen by the scene options).
+SCHEME_ID = 100
 # A rigidly attached block sits exactly on the surface; the plate's height recomputed at
 # an output time (exact sin/cos instead of the step's recurrence) may differ in the last
 # bits.  Penetrations down to -ATTACHED_TOLERANCE (1 + |z|) still count as attached: any
@@ -52,7 +57,7 @@ RIGID, FROZEN, COULOMB = 1, 2, 4
 ATTACHED_TOLERANCE = 1e-12
 
 
-@njit(cache=True)
+@njit(inline="always")
 def orbit_response(prm, amplitude, omega):
     """Complex amplitude R of the steady orbit y = z - Z_p = -W/k_n + Im(R e^{i theta}) of
     m y'' + gamma_n y' + k_n y = -W + m A omega^2 sin(theta) (model A, W = m g)."""
@@ -70,7 +75,7 @@ def frozen_penetration(prm, omega, r_re, r_im, s, c, ext_a):
     return (m * (prm[P_G] + ext_a)) / prm[P_KN] - rot_im, omega * rot_re
 
 
-@njit(cache=True)
+@njit(inline="always")
 def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, frozen_pen1, frozen_un1,
                track_energy):
     """One reduced step of length h.  Returns (x, z, vx, vz, F, engaged, N, T, d_phi, d_work,
@@ -159,12 +164,6 @@ def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, 
 
 
 @njit(inline="always")
-def _plate(drv, s, c, t):
-    return plate_motion(drv[D_AMP], drv[D_OMEGA], s, c, drv[D_EXT_Z], drv[D_EXT_V], drv[D_EXT_A],
-                        t - drv[D_EXT_T])
-
-
-@njit(inline="always")
 def _end_normal(kind, rigid, x, z, vx, vz, pz, pv, step_normal, prm):
     """The normal force the friction rule sees at a step's end: the step's constraint
     force for a rigid contact, the spring-dashpot's at the new state otherwise."""
@@ -173,73 +172,40 @@ def _end_normal(kind, rigid, x, z, vx, vz, pz, pv, step_normal, prm):
     return contact(kind, x, z, vx, vz, pz, pv, prm)[5]
 
 
-@njit(cache=True)
-def advance_scene(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
-    """Advance by up to n_steps reduced steps.  Returns (steps taken, released): with
-    FROZEN the kernel stops before a step at whose end the frozen orbit would lose
-    contact (released = True; the caller continues with the full model).  Steps taken
-    is -1 if the state stopped being finite (arrays left as on entry)."""
-    t0, dt = drv[D_T0], drv[D_DT]
-    half_kt = 0.5 * prm[P_KT]
+@njit(inline="always")
+def prepare(kind, flags, drv, prm, h):
+    """The frozen orbit's complex amplitude (``orbit_response``)."""
+    return orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
+
+
+@njit(inline="always")
+def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+    """One reduced step (``scene_step``) under the driver's contract.  With FROZEN it
+    returns STOP, the step not taken, where the frozen orbit would lose contact at the
+    step's end: the caller hands over to the full model there."""
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
     rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
-    r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
-    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
-    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
-    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
-    n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
-    rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
-    s, c = drive_sin_cos(drv, cnt, n)
-    t = t0 + n * dt
-    pz0, pv0 = _plate(drv, s, c, t)
-    done = 0
-    released = False
-    while done < n_steps:
-        n1 = n + 1
-        if ((n1 - anchor) & (RESYNC - 1)) == 0:
-            phase = drive_phase(drv, cnt, n1)
-            s1, c1 = math.sin(phase), math.cos(phase)
-        else:
-            s1, c1 = s * rot_c + c * rot_s, c * rot_c - s * rot_s
-        t_new = t0 + n1 * dt
-        pz1, pv1 = _plate(drv, s1, c1, t_new)
-        pen_f, un_f = 0.0, 0.0
-        if frozen:
-            pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, s1, c1, drv[D_EXT_A])
-            if pen_f <= 0.0:  # the guard: the block would detach here, hand over
-                released = True
-                break
-        x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
-            kind, flags, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz1, pv1, pen_f, un_f, track_energy)
-        loaded = shear
-        if coulomb:
-            shear = 0.0
-        else:
-            end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
-            shear, reset = friction_rule(shear, 1.0 if engaged else 0.0, end_normal, prm)
-            slips += reset
-        phi, phi_c = kahan_add(phi, phi_c, d_phi)
-        if track_energy:
-            work += d_work
-            dissipated += d_dissipated + half_kt * (loaded * loaded - shear * shear)
-            e_normal += d_normal
-        n, s, c, t, pz0, pv0 = n1, s1, c1, t_new, pz1, pv1
-        done += 1
-        if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
-            return -1, False
-    if not is_finite_state(x, z, vx, vz, shear):
-        return -1, False
-    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
-    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
-    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
-    cnt[C_STEP], cnt[C_SLIPS] = n, slips
-    return done, released
+    pen_f, un_f = 0.0, 0.0
+    if frozen:
+        pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], ctx[0], ctx[1], s1, c1, drv[D_EXT_A])
+        if pen_f <= 0.0:  # the guard: the block would detach here, hand over
+            return STOP, x, z, vx, vz, shear, contact0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
+        kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, pen_f, un_f, track_energy)
+    if coulomb:  # no spring: nothing to reset (the driver's rule sees no contact and keeps F = 0)
+        return OK, x, z, vx, vz, shear, contact0, 0.0, 0.0, d_phi, d_work, d_dissipated, d_normal
+    end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
+    # contact0 is passed on unused: the reduced step works out its contact itself.
+    return (OK, x, z, vx, vz, shear, contact0, 1.0 if engaged else 0.0, end_normal, d_phi, d_work, d_dissipated,
+            d_normal)
 
 
 @njit(cache=True)
-def observe_scene(kind, flags, y, cnt, drv, prm, h, track_energy):
-    """``stepping.observe`` for a reduced block, plus the Coulomb friction force: the
-    state at t_n + h (one scratch step from the grid state), and the normal and friction
-    forces acting there (those of a step of dt starting at that state)."""
+def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
+    """``fixed_step.observe`` for a reduced block: the state at t_n + h (one scratch step
+    from the grid state), and the contact state, normal and friction forces acting there
+    (those of a step of dt starting at that state)."""
+    kind = literally(kind)
     dt = drv[D_DT]
     rigid, coulomb = (flags & RIGID) != 0, (flags & COULOMB) != 0
     r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
@@ -250,11 +216,10 @@ def observe_scene(kind, flags, y, cnt, drv, prm, h, track_energy):
     # At the grid point, the plate exactly as the kernel saw it (its sin/cos recurrence):
     # a rigidly attached block then sits on the surface to the last bit.
     s0, c0 = drive_sin_cos(drv, cnt, cnt[C_STEP])
-    pz0, pv0 = _plate(drv, s0, c0, t)
-    anchor_time = drv[D_T0] + cnt[C_PHASE_STEP] * dt
+    pz0, pv0 = plate_at(drv, s0, c0, t)
     if h > 0.0:
-        pz1, pv1 = plate_at_time(drv, cnt, prm, t + h)
-        phase = drv[D_PHASE] + drv[D_OMEGA] * (t + h - anchor_time)
+        pz1, pv1 = plate_at_time(drv, cnt, t + h)
+        phase = phase_at_time(drv, cnt, t + h)
         pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase),
                                          drv[D_EXT_A])
         x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
@@ -274,8 +239,8 @@ def observe_scene(kind, flags, y, cnt, drv, prm, h, track_energy):
         t += h
         pz0, pv0 = pz1, pv1
     # The forces acting at the reported state: those of a step of dt starting there.
-    pz2, pv2 = plate_at_time(drv, cnt, prm, t + dt)
-    phase = drv[D_PHASE] + drv[D_OMEGA] * (t + dt - anchor_time)
+    pz2, pv2 = plate_at_time(drv, cnt, t + dt)
+    phase = phase_at_time(drv, cnt, t + dt)
     pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase), drv[D_EXT_A])
     probe = scene_step(kind, flags, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz2, pv2, pen_f, un_f, False)
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz0, pv0, prm)
@@ -284,5 +249,10 @@ def observe_scene(kind, flags, y, cnt, drv, prm, h, track_energy):
         normal = probe[6]
         in_contact = pen >= -ATTACHED_TOLERANCE * (1.0 + abs(z)) and normal > 0.0
     friction = probe[7] if coulomb else (-prm[P_KT] * shear if in_contact else 0.0)
-    return (x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, work, dissipated, e_normal, t,
-            in_contact, friction)
+    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = x, z, vx, vz, shear
+    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, cos_a
+    obs[O_PHI], obs[O_SLIPS], obs[O_T] = phi, slips, t
+    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = work, dissipated, e_normal
+    obs[O_CONTACT] = 1.0 if in_contact else 0.0
+    obs[O_FRICTION] = friction
+    return N_OBS

@@ -1,38 +1,137 @@
-"""The model variants and the compiled dispatch onto their geometry and load.
+"""The model variants: a registry built from the modules in this package.
 
-Each variant is a small module stating two things:
+A variant is one module ``model_<name>.py`` stating:
 
+* its docstring, whose first line describes it in the FMU and the docs;
+* ``PARAMETERS``: the optional common parameters it has (e.g. ``"g"``) and its own
+  ``Parameter`` records (corrugation, confining force, ...), in the FMU's order;
+* ``DEFAULTS``: common parameters whose default differs for this variant;
 * ``profile(x, prm) -> (height, slope)``: the plate surface's static shape, added to
-  the plate's vertical motion (so Z_p(x, t) = plate(t) + height(x));
+  the plate's vertical motion (Z_p(x, t) = plate(t) + height(x));
 * ``load(cos_a, sin_a, prm) -> (fx, fz)``: the confining force on the block, given the
   unit tangent (cos a, sin a) of the surface under it.
 
-Everything else (contact, friction, stepping) is shared.  Adding a variant is a
-module plus one line in each dispatch function below and in ``MODELS``.
+Everything else (contact, friction, integrators, the FMU, the docs) is shared and
+reads this registry: adding a variant is adding a module.  The compiled kernels reach a
+variant's ``profile`` and ``load`` through ``profile(kind, ...)`` and
+``load(kind, ...)`` below, resolved at compile time from the kernel's constant ``kind``
+(the kernels take ``kind`` as a literal), so each kernel is compiled for the variants
+it is used with only.
 """
-from numba import njit
+from __future__ import annotations
 
-from . import model_a, model_b, model_c
+import importlib
+import pkgutil
+from dataclasses import dataclass, replace
+from types import ModuleType
+from typing import Callable
 
-MODEL_A, MODEL_B, MODEL_C = 0, 1, 2
-MODELS = {"A": MODEL_A, "B": MODEL_B, "C": MODEL_C}
-DESCRIPTIONS = {name: module.__doc__.strip().splitlines()[0]
-                for name, module in (("A", model_a), ("B", model_b), ("C", model_c))}
+from .. import jitcache  # noqa: F401  (before numba: the kernel cache's folder and locator)
+from numba import types  # noqa: E402
+from numba.extending import overload  # noqa: E402
+
+from ..parameters import COMMON_PARAMETERS, OPTIONAL_COMMON, VARIANT_AFTER, Parameter  # noqa: E402
+
+MODULE_PREFIX = "model_"
 
 
-@njit(inline="always", cache=True)
+@dataclass(frozen=True)
+class Variant:
+    name: str
+    kind: int  # index in the registry; a compile-time constant of the kernels
+    description: str
+    parameters: tuple[Parameter, ...]  # the FMU's parameters of this variant, in order
+    profile: Callable
+    load: Callable
+    module: ModuleType
+
+    @property
+    def fmu_name(self) -> str:
+        return f"Block{self.name}"
+
+    def defaults(self) -> dict[str, float]:
+        return {p.name: p.default for p in self.parameters}
+
+
+def _assemble_parameters(module: ModuleType) -> tuple[Parameter, ...]:
+    declared = getattr(module, "PARAMETERS", ())
+    optional = {p for p in declared if isinstance(p, str)}
+    unknown = optional - set(OPTIONAL_COMMON)
+    if unknown:
+        raise ValueError(f"{module.__name__}: {sorted(unknown)} are not optional common parameters {OPTIONAL_COMMON}")
+    own = tuple(p for p in declared if isinstance(p, Parameter))
+    overrides = dict(getattr(module, "DEFAULTS", {}))
+    out = []
+    for p in COMMON_PARAMETERS:
+        if p.name in OPTIONAL_COMMON and p.name not in optional:
+            continue
+        out.append(replace(p, default=overrides.pop(p.name)) if p.name in overrides else p)
+        if p.name == VARIANT_AFTER:
+            out.extend(own)
+    if overrides:
+        raise ValueError(f"{module.__name__}: DEFAULTS names unknown parameters {sorted(overrides)}")
+    return tuple(out)
+
+
+def _discover() -> dict[str, Variant]:
+    names = sorted(info.name for info in pkgutil.iter_modules(__path__) if info.name.startswith(MODULE_PREFIX))
+    found = {}
+    for kind, module_name in enumerate(names):
+        module = importlib.import_module(f"{__name__}.{module_name}")
+        name = module_name[len(MODULE_PREFIX):].upper()
+        description = module.__doc__.strip().splitlines()[0].rstrip(".")
+        found[name] = Variant(name, kind, description, _assemble_parameters(module), module.profile,
+                              module.load, module)
+    return found
+
+
+VARIANTS: dict[str, Variant] = _discover()
+_BY_KIND = {v.kind: v for v in VARIANTS.values()}
+MODELS = {name: v.kind for name, v in VARIANTS.items()}  # name -> kind
+DESCRIPTIONS = {name: v.description for name, v in VARIANTS.items()}
+
+
+def variant(model: str) -> Variant:
+    try:
+        return VARIANTS[model]
+    except KeyError:
+        raise KeyError(f"unknown model {model!r}; choose one of {sorted(VARIANTS)}") from None
+
+
+def parameters_for(model: str) -> tuple[Parameter, ...]:
+    """The parameters of one model variant, with that variant's defaults."""
+    return variant(model).parameters
+
+
+def defaults(model: str) -> dict[str, float]:
+    return variant(model).defaults()
+
+
+def offered_by(models: str) -> list[str]:
+    """The variants a table entry names: ``*`` for all, else a string of variant names."""
+    return sorted(VARIANTS) if models == "*" else [m for m in models if m in VARIANTS]
+
+
+# ---------------------------------------------------------------- compiled dispatch
 def profile(kind, x, prm):
-    if kind == MODEL_A:
-        return model_a.profile(x, prm)
-    if kind == MODEL_B:
-        return model_b.profile(x, prm)
-    return model_c.profile(x, prm)
+    """Surface height and slope of variant ``kind`` at x (compiled code only)."""
 
 
-@njit(inline="always", cache=True)
 def load(kind, cos_a, sin_a, prm):
-    if kind == MODEL_A:
-        return model_a.load(cos_a, sin_a, prm)
-    if kind == MODEL_B:
-        return model_b.load(cos_a, sin_a, prm)
-    return model_c.load(cos_a, sin_a, prm)
+    """Confining force of variant ``kind`` (compiled code only)."""
+
+
+@overload(profile, inline="always")
+def _profile(kind, x, prm):
+    if isinstance(kind, types.IntegerLiteral):
+        geometry = _BY_KIND[kind.literal_value].profile
+        return lambda kind, x, prm: geometry(x, prm)
+    return None  # the kernel must pass kind as a literal (numba.literally)
+
+
+@overload(load, inline="always")
+def _load(kind, cos_a, sin_a, prm):
+    if isinstance(kind, types.IntegerLiteral):
+        force = _BY_KIND[kind.literal_value].load
+        return lambda kind, cos_a, sin_a, prm: force(cos_a, sin_a, prm)
+    return None

@@ -3,6 +3,8 @@ from numba import njit
 
 from ..layout import P_G, P_M
 
+PARAMETERS = ("g",)
+
 
 @njit(inline="always")
 def profile(x, prm):

@@ -1,4 +1,4 @@
-"""Stiff-stable stepping (integrator ``implicit_contact``, id 3): the linear contact
+"""``implicit_contact`` (id 3), stiff-stable stepping: the linear contact
 spring-dashpots are integrated in closed form, everything else is held over the step.
 
 Why
@@ -43,7 +43,7 @@ The scheme (one step of length h)
    to, alpha(x + h vx) (reading them in the frame at the new x instead costs an O(h^2)
    error per step: the two differ by O(h^2)); the plate's position and velocity are
    exact at t + h.  The caller then applies the friction rule at the new state (the
-   contract in ``stepping``).
+   contract in ``integrators``).
 
 Order and stability
 -------------------
@@ -70,22 +70,19 @@ Order and stability
   the splitting error alone (second order for smooth motion) and not a quadrature error
   of the stiff forces.
 
-Status codes (``advance`` returns them instead of a step count): -1 non-finite state
+Status codes (the driver returns them): -1 non-finite state
 (as every integrator), TOO_MANY_SWITCHES (more than MAX_SEGMENTS contact switches in one
 step), TOO_FAST_FOR_CORRUGATION (see above).  The arrays are left as they were on entry.
 """
 import math
 
 import numpy as np
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from .dynamics import contact, plate_motion
-from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z,
-                     D_OMEGA, D_T0, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F,
-                     Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
-from .models import load, profile
-from .stepping import (FINITE_CHECK, RESYNC, drive_phase, drive_sin_cos, is_finite_state,
-                       settle_step, store_state)
+from ..dynamics import contact
+from ..layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_VD
+from ..models import load, profile
 
 TOO_MANY_SWITCHES = -2
 TOO_FAST_FOR_CORRUGATION = -3
@@ -512,67 +509,21 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
     return 0, x1, z1, vx1, vz1, f, d_phi, work, dissipated, e_normal
 
 
-# ---------------------------------------------------------------------- the run
+# ---------------------------------------------------------------------- the scheme
 @njit(inline="always")
-def _plate(drv, s, c, t):
-    return plate_motion(drv[D_AMP], drv[D_OMEGA], s, c, drv[D_EXT_Z], drv[D_EXT_V], drv[D_EXT_A],
-                        t - drv[D_EXT_T])
+def prepare(kind, flags, drv, prm, h):
+    """The step's propagators and the scratch arrays for the contact segments of a step."""
+    return (step_propagators(prm, h), np.empty(MAX_SEGMENTS), np.empty(MAX_SEGMENTS, dtype=np.bool_))
 
 
-@njit(cache=True)
-def advance_implicit_contact(kind, y, cnt, drv, prm, n_steps, track_energy):
-    """Advance by n_steps steps (the contract in ``stepping``); returns the steps taken or a
-    negative status, leaving the arrays as they were on entry."""
-    t0, dt = drv[D_T0], drv[D_DT]
-    table = step_propagators(prm, dt)
-    seg_len = np.empty(MAX_SEGMENTS)
-    seg_contact = np.empty(MAX_SEGMENTS, dtype=np.bool_)
-    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
-    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
-    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
-    n, slips, anchor = cnt[C_STEP], cnt[C_SLIPS], cnt[C_PHASE_STEP]
-    rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
-    s, c = drive_sin_cos(drv, cnt, n)
-    t = t0 + n * dt
-    pz0, pv0 = _plate(drv, s, c, t)
-    done = 0
-    while done < n_steps:
-        n += 1
-        done += 1
-        if ((n - anchor) & (RESYNC - 1)) == 0:
-            phase = drive_phase(drv, cnt, n)
-            s, c = math.sin(phase), math.cos(phase)
-        else:
-            s, c = s * rot_c + c * rot_s, c * rot_c - s * rot_s
-        t_new = t0 + n * dt
-        pz1, pv1 = _plate(drv, s, c, t_new)
-        # The step is dt exactly (the table's); t_new - t would carry the rounding of large t.
-        status, x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = implicit_contact_step(
-            kind, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz1, pv1, table, seg_len, seg_contact, track_energy)
-        if status < 0:
-            return status
-        pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-        shear, slips, phi, phi_c, work, dissipated, e_normal = settle_step(
-            prm, shear, pen, normal, slips, phi, phi_c, work, dissipated, e_normal,
-            d_phi, d_work, d_dissipated, d_normal, track_energy)
-        t, pz0, pv0 = t_new, pz1, pv1
-        if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
-            return -1
-    if not is_finite_state(x, z, vx, vz, shear):
-        return -1
-    store_state(y, cnt, x, z, vx, vz, shear, phi, phi_c, work, dissipated, e_normal, n, slips)
-    return done
-
-
-@njit(cache=True)
-def implicit_contact_scratch(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, track_energy):
-    """One step of length h < dt for outputs between grid points (``stepping.observe``).
-    If the step cannot be taken the grid state is returned unchanged."""
-    table = step_propagators(prm, h)
-    seg_len = np.empty(MAX_SEGMENTS)
-    seg_contact = np.empty(MAX_SEGMENTS, dtype=np.bool_)
-    status, x1, z1, vx1, vz1, f1, d_phi, d_work, d_dissipated, d_normal = implicit_contact_step(
+@njit(inline="always")
+def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+    # The step is h exactly (the propagator table's); the grid times' difference would
+    # carry the rounding of large t.
+    table, seg_len, seg_contact = ctx
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    status, x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = implicit_contact_step(
         kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, table, seg_len, seg_contact, track_energy)
-    if status < 0:
-        return x, z, vx, vz, shear, 0.0, 0.0, 0.0, 0.0
-    return x1, z1, vx1, vz1, f1, d_phi, d_work, d_dissipated, d_normal
+    contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+    return (status, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated,
+            d_normal)

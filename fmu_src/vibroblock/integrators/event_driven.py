@@ -1,4 +1,4 @@
-"""Event-driven exact integration of model A (flat plate), compiled with numba.
+"""``event_driven`` (id 2, model A only): exact integration between located events.
 
 Between events model A is linear with sinusoidal and polynomial forcing, and its
 vertical and horizontal motions decouple:
@@ -62,11 +62,14 @@ import cmath
 import math
 
 import numpy as np
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from .layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
+from ..layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
                      D_PHASE, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED,
-                     Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+                     Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS, O_CONTACT, O_COS,
+                     O_DISSIPATED, O_E_NORMAL, O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T,
+                     O_VX, O_VZ, O_WORK, O_X, O_Z)
 
 # Events are located to this time (tau_0) past their true zero, or to 8 ulp of the time
 # since the segment began, whichever is larger.
@@ -937,9 +940,16 @@ def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, 
 
 
 @njit(cache=True)
-def advance_event_driven(y, cnt, drv, prm, n_steps, track_energy, tol=EVENT_TOL, skip_periods=True):
+def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     """Advance model A by n_steps grid steps exactly (see the module doc): the end time
-    t0 + (n + n_steps) dt is reached directly, whatever n_steps is."""
+    t0 + (n + n_steps) dt is reached directly, whatever n_steps is.  Returns 0, or -1
+    (the arrays untouched) if the state stopped being finite."""
+    return advance_exact(y, cnt, drv, prm, n_steps, track_energy, EVENT_TOL, True)
+
+
+@njit(cache=True)
+def advance_exact(y, cnt, drv, prm, n_steps, track_energy, tol, skip_periods):
+    """``advance`` with its event tolerance and period skipping chosen (for tests)."""
     n = cnt[C_STEP]
     out = y.copy()
     slips = _evolve(y, cnt[C_SLIPS], drv, prm, cnt[C_PHASE_STEP], n, 0.0, n + n_steps, 0.0, track_energy, tol,
@@ -949,13 +959,13 @@ def advance_event_driven(y, cnt, drv, prm, n_steps, track_energy, tol=EVENT_TOL,
     y[:] = out
     cnt[C_STEP] = n + n_steps
     cnt[C_SLIPS] = slips
-    return n_steps
+    return 0
 
 
 @njit(cache=True)
-def observe_event_driven(y, cnt, drv, prm, h, track_energy):
-    """State at t_n + h (0 <= h < dt) by the exact flow, without touching the stored
-    state; same tuple as stepping.observe."""
+def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
+    """Fill ``obs`` with the state at t_n + h (0 <= h < dt) by the exact flow, without
+    touching the stored state (the layout of ``fixed_step.observe``)."""
     n = cnt[C_STEP]
     out = y.copy()
     slips = cnt[C_SLIPS]
@@ -972,5 +982,10 @@ def observe_event_driven(y, cnt, drv, prm, h, track_energy):
     plate_v = drv[D_AMP] * om * math.cos(th) + drv[D_EXT_V] + drv[D_EXT_A] * tau_e
     pen = plate_z - out[Y_Z]
     normal = prm[P_KN] * pen - prm[P_GN] * (out[Y_VZ] - plate_v) if pen > 0.0 else 0.0
-    return (out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F], pen, normal, 1.0, out[Y_PHI], slips,
-            out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL], t)
+    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F]
+    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, 1.0
+    obs[O_PHI], obs[O_SLIPS], obs[O_T] = out[Y_PHI], slips, t
+    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL]
+    obs[O_CONTACT] = 1.0 if pen > 0.0 else 0.0
+    obs[O_FRICTION] = -prm[P_KT] * out[Y_F] if pen > 0.0 else 0.0
+    return N_OBS

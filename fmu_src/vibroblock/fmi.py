@@ -1,0 +1,146 @@
+"""The FMI 2.0 co-simulation facade shared by every vibroblock FMU (pythonfmu).
+
+An FMU class holds no physics: it registers its variables and maps the FMI calls onto
+one object of the core (a ``Block``, an ``Excitation`` signal).  This base does what
+every FMU needs the same way:
+
+* Errors.  pythonfmu turns a Python exception into fmi2Fatal and discards the Python
+  instance, so no exception may leave a facade.  A rejected call logs its reason with
+  status fmi2Error, keeps the last good state and returns normally (doStep returns
+  False); the FMU's native status shim (build/fmi_status_shim.c) turns a call that
+  logged an error into an fmi2Error return.
+* Time.  The start time is checked; a doStep must start at the FMU's own time (to go
+  back, a master restores an FMU state) and have a finite positive size.
+* FMU state.  pythonfmu's default captures registered scalars only; the facades capture
+  their core object whole (``_capture`` / ``_restore``), so hysteresis runs and
+  rollbacks continue bit for bit.
+* pythonfmu 0.7.0's loader re-executes the FMU script at every instantiation and then
+  releases a reference to the script's namespace that it only borrowed
+  (PyModule_GetDict); unbalanced, the namespace is freed under the live module after
+  the first instance and the host crashes later.  ``fmu_class`` hands one reference
+  back per execution, held for the life of the process.
+
+An FMU script is then a few lines: pythonfmu's native loader finds the slave class by
+the literal text ``class Name(Fmi2Slave):`` in the script, so the script declares that
+and the ``fmu_class`` decorator puts this base (and the facade's own class) under it.
+"""
+from __future__ import annotations
+
+import math
+import sys
+import traceback
+
+from pythonfmu import Fmi2Slave
+from pythonfmu.enums import Fmi2Status
+
+_NAMESPACES_RELEASED_BY_LOADER: list = []
+
+
+class FmuFacade(Fmi2Slave):
+    """Error guard, time checks and FMU state handling; subclasses provide the hooks."""
+
+    author = "vibroblock"
+    license = "MIT"
+    version = "0.1.0"
+    # Exceptions whose message is the user's answer (a rejected value or request).
+    rejected = (ValueError,)
+    what = "the FMU"  # names the FMU in messages
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.start_time = 0.0
+
+    # ------------------------------------------------------------------ hooks
+    def _is_started(self) -> bool:
+        raise NotImplementedError
+
+    def _time(self) -> float:
+        raise NotImplementedError
+
+    def _start(self, start_time: float) -> None:
+        raise NotImplementedError
+
+    def _advance_to(self, end_time: float) -> None:
+        raise NotImplementedError
+
+    def _capture(self) -> dict:
+        raise NotImplementedError
+
+    def _restore(self, state: dict) -> None:
+        raise NotImplementedError
+
+    def _changed(self) -> None:
+        """Called after every accepted request (e.g. to drop cached outputs)."""
+
+    # ------------------------------------------------------------------ guarding
+    def _guard(self, action, *args) -> bool:
+        """Run one request; on a bad request log fmi2Error and keep the last good state."""
+        try:
+            action(*args)
+            self._changed()
+            return True
+        except self.rejected as exc:
+            self.log(str(exc), Fmi2Status.error)
+        except Exception as exc:  # a host must never see a Python exception (see module doc)
+            self.log(f"internal error: {exc!r}\n{traceback.format_exc()}", Fmi2Status.error)
+        return False
+
+    # ------------------------------------------------------------------ FMI calls
+    def setup_experiment(self, start_time=0.0, stop_time=None, tolerance=None):
+        if start_time is not None and not math.isfinite(start_time):
+            self.log(f"start time {start_time!r} is not finite; 0 is used", Fmi2Status.error)
+            return
+        self.start_time = float(start_time or 0.0)
+        self._changed()
+
+    def exit_initialization_mode(self):
+        return self._guard(self._start, self.start_time)
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        return self._guard(self._do_step, current_time, step_size)
+
+    def _do_step(self, current_time: float, step_size: float) -> None:
+        if not self._is_started():
+            raise self.rejected[0]("doStep before a successful initialization (see earlier errors)")
+        if not (math.isfinite(step_size) and step_size > 0.0):
+            raise self.rejected[0](f"communication step size {step_size!r} must be a finite number > 0")
+        now = self._time()
+        if not math.isfinite(current_time) or abs(current_time - now) > 1e-9 * max(1.0, abs(now)):
+            raise self.rejected[0](f"communication point {current_time!r} differs from the FMU's time {now!r}; "
+                                   "to go back in time restore an FMU state first")
+        self._advance_to(now + step_size)
+
+    def terminate(self):
+        pass
+
+    # ------------------------------------------------------------------ FMU state
+    def _get_fmu_state(self):
+        try:
+            return self._capture()
+        except Exception as exc:
+            self.log(f"could not capture the FMU state: {exc!r}", Fmi2Status.error)
+            return {}
+
+    def _set_fmu_state(self, state):
+        try:
+            self._restore(state)
+            self._changed()
+        except self.rejected as exc:
+            self.log(f"{exc}; the current state is kept", Fmi2Status.error)
+        except (KeyError, TypeError, ValueError) as exc:
+            self.log(f"not a valid FMU state for {self.what}: {exc!r}; the current state is kept", Fmi2Status.error)
+        except Exception as exc:
+            self.log(f"internal error while restoring the FMU state: {exc!r}", Fmi2Status.error)
+
+
+def fmu_class(facade: type):
+    """Class decorator for an FMU script's ``class Name(Fmi2Slave)``: returns a class of
+    that name built on ``facade`` (a subclass of ``FmuFacade``), with the script class's
+    own attributes (its docstring, ...) on top."""
+    def decorate(cls):
+        module = sys.modules.get(cls.__module__)
+        if module is not None:
+            _NAMESPACES_RELEASED_BY_LOADER.append(vars(module))
+        own = {k: v for k, v in vars(cls).items() if k not in ("__dict__", "__weakref__")}
+        return type(cls.__name__, (facade,), own)
+    return decorate

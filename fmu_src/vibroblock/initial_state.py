@@ -1,0 +1,53 @@
+"""The block's initial state (``initial_state``): at rest, as given, or on the steady
+in-contact orbit of the drive (``orbits.steady_orbit``), and its placement for a
+reduced scene."""
+from __future__ import annotations
+
+import math
+
+from . import layout as L
+from .orbits import steady_orbit
+from .settings import Settings
+
+
+def place(settings: Settings, prm, drv, y) -> bool:
+    """Set position and velocity in ``y`` for a run starting at the drive phase in ``drv``.
+    Returns False if a frozen vertical motion cannot start (its orbit does not keep
+    contact): the caller hands over to the full model at once."""
+    p, variant = settings.parameters, settings.variant
+    x = p["x_start"]
+    height, slope = variant.profile(x, prm)
+    cos_a, sin_a = 1.0 / math.sqrt(1.0 + slope * slope), slope / math.sqrt(1.0 + slope * slope)
+    phase = drv[L.D_PHASE]
+    plate_z = p["A"] * math.sin(phase) + height
+    plate_v = p["A"] * p["omega"] * math.cos(phase)
+    # The confining load's component into the plate sets the rest penetration.
+    load_x, load_z = variant.load(cos_a, sin_a, prm)
+    weight = max(0.0, -(-load_x * sin_a + load_z * cos_a))
+    y[L.Y_X], y[L.Y_VX] = x, p["vx_start"]
+    if settings.initial_state == 0:
+        y[L.Y_Z] = plate_z - weight / (p["k_n"] * cos_a)
+        y[L.Y_VZ] = p["vz_start"]
+    elif settings.initial_state == 1:
+        y[L.Y_Z], y[L.Y_VZ] = p["z_start"], p["vz_start"]
+    else:
+        offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+        y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
+    return _place_for_scene(settings, prm, drv, y)
+
+
+def _place_for_scene(settings: Settings, prm, drv, y) -> bool:
+    """A rigid contact starts on the surface (moving with it unless initial_state = 1);
+    a frozen vertical motion starts on its orbit if that orbit keeps contact."""
+    p = settings.parameters
+    phase = drv[L.D_PHASE]
+    plate_z, plate_v = p["A"] * math.sin(phase), p["A"] * p["omega"] * math.cos(phase)
+    if settings.scene["rigid_contact"] and settings.initial_state != 1:
+        height, slope = settings.variant.profile(y[L.Y_X], prm)
+        y[L.Y_Z], y[L.Y_VZ] = plate_z + height, plate_v + slope * y[L.Y_VX]
+    if settings.scene["frozen_vertical"]:
+        offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], p["m"] * p["g"], p["A"], p["omega"], phase)
+        if offset >= 0.0:
+            return False
+        y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
+    return True

@@ -1,0 +1,185 @@
+"""The integrators: one registry, one contract, one fixed-step driver.
+
+Each integrator is one record in ``INTEGRATORS`` (id, name, the models it supports,
+its cost and stability limit, its advance and observe kernels, its status messages).
+``Block``, the FMU's ``integrator`` parameter, the README table and the benchmarks read
+this registry; adding an integrator is one module and one record here.  A fixed-step
+scheme is a ``prepare``/``step`` pair run by the shared driver (``fixed_step``); an
+integrator that is not fixed-step brings its own ``advance``/``observe`` kernels
+(``event_driven``).
+
+The contract every integrator keeps (``tests/fmu_src/vibroblock/test_integrators.py``
+checks every registered one against the rules a test can check):
+
+1. Grid.  The state is stored on the grid t_n = t0 + n dt, n = cnt[C_STEP]; time is
+   never accumulated.  ``advance(kind, method, flags, y, cnt, drv, prm, n_steps,
+   track_energy)`` moves it by whole grid steps; between grid points outputs come from
+   ``observe(..., h, track_energy, obs)``, which fills ``obs`` (``layout.O_*``) with the
+   state at t_n + h without touching the stored state.
+2. Friction rule.  The stored state satisfies the paper's rule: F = 0 out of contact,
+   |k_t F| < mu_s N in contact.  The rule is applied at the end of every step, at the
+   new state; a reset of a loaded spring increments cnt[C_SLIPS] and releases
+   k_t F^2 / 2 into the dissipated energy.
+3. Splits.  The plate drive is a function of the grid index alone, so advancing n1 + n2
+   steps in two calls gives the same bits as n1 + n2 in one (an integrator whose
+   ``splits_bitwise`` is False -- exact flows with located events -- agrees to its
+   event tolerance instead).
+4. Failure.  ``advance`` returns 0 (OK), 1 (STOP: a guard stopped it early, the steps
+   taken are stored) or a negative status from ``statuses``; on a negative status the
+   arrays are exactly as they were on entry (the last good state).
+5. Energy.  With ``track_energy`` the work done on the block, the energy dissipated and
+   the normal spring's energy are accumulated (``dynamics.energy_rates``) to the
+   scheme's own order, so that stored - start - work + dissipated measures its error.
+6. Costs.  Located events and rejected steps are counted in cnt[C_EVENTS] and
+   cnt[C_REJECTED] by the integrators that locate or reject.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from . import event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
+from .fixed_step import NON_FINITE, OK, STOP
+
+
+def _spring_dashpot_limit(limit: float):
+    """Stability check of an explicit scheme: dt^2 k/m + 2 dt gamma/m <= limit for the
+    normal and the tangential contact."""
+    def check(p: dict, model: str, name: str) -> str | None:
+        dt = p["dt"]
+        for what, k, gamma in (("normal contact", p["k_n"], p["gamma_n"]),
+                               ("tangential contact", p["k_t"], p["gamma_t"])):
+            k_m, c_m = k / p["m"], gamma / p["m"]
+            if dt * dt * k_m + 2.0 * dt * c_m > limit:
+                dt_max = (limit / (2.0 * c_m) if k_m == 0.0
+                          else (-c_m + math.sqrt(c_m * c_m + limit * k_m)) / k_m)
+                return (f"dt = {dt:g} is too large for the {what} (k/m = {k_m:g}, gamma/m = {c_m:g}) with "
+                        f"{name}: dt^2 k/m + 2 dt gamma/m must stay <= {limit:g}; use dt <= {dt_max:.3g}")
+        return None
+    return check
+
+
+def _implicit_contact_limit(p: dict, model: str, name: str) -> str | None:
+    """implicit_contact integrates the contact spring-dashpots, and the drive spring's
+    pull along the tangent, exactly: on a flat plate nothing limits dt but the search
+    for a release inside a step (at most MAX_PIECES half contact periods).  On a
+    corrugated plate the frame is frozen over a step and what couples through it stays
+    explicit - the drive's pull across the slope and the load's pull along the curved
+    surface (stiffness up to load x A_x omega_x^2): dt^2 (k_d + load A_x omega_x^2)/m <= 1."""
+    dt = p["dt"]
+    curvature = p.get("A_x", 0.0) * p.get("omega_x", 0.0) ** 2  # largest |Z_p''| of the corrugation
+    if curvature > 0.0:
+        confining = p["P_l"] if "P_l" in p else p["m"] * p["g"]
+        k_m = (p["k_d"] + confining * curvature) / p["m"]
+        if dt * dt * k_m > 1.0:
+            return (f"dt = {dt:g} is too large for the corrugated plate with implicit_contact: the drive spring and "
+                    f"the load's pull along the curved surface (k_d + load A_x omega_x^2)/m = {k_m:g} stay explicit, "
+                    f"dt^2 times it must stay <= 1; use dt <= {1.0 / math.sqrt(k_m):.3g}")
+    half_periods = dt * math.sqrt(p["k_n"] / p["m"]) / math.pi
+    if half_periods >= implicit_contact.MAX_PIECES:
+        return (f"dt = {dt:g} spans {half_periods:.3g} half periods of the normal contact (k_n/m = "
+                f"{p['k_n'] / p['m']:g}); implicit_contact searches at most {implicit_contact.MAX_PIECES} per step "
+                f"for a release; use dt <= {implicit_contact.MAX_PIECES * math.pi / math.sqrt(p['k_n'] / p['m']):.3g}")
+    return None
+
+
+def _no_limit(p: dict, model: str, name: str) -> str | None:
+    return None
+
+
+# Messages of the failure statuses; {t}, {t_end}, {dt}, {integrator} are filled in.
+NON_FINITE_MESSAGE = ("the state became non-finite while integrating from t = {t:g} to t = {t_end:g} (dt = {dt:g}, "
+                      "{integrator}); the state at t = {t:g} is kept. Reduce dt or check the parameters for extreme "
+                      "values.")
+
+
+@dataclass(frozen=True)
+class Integrator:
+    id: int  # the FMU's ``integrator`` value: stable, never reused
+    name: str
+    summary: str  # one line for the FMU's description and the README
+    models: str  # "*" for every variant, else the variant names it supports
+    force_evaluations: int  # per internal step (0: the cost is per event, not per step)
+    check_step: Callable[[dict, str, str], str | None]  # why dt is not admissible, or None
+    advance: Callable
+    observe: Callable
+    statuses: dict[int, str] = field(default_factory=dict)  # failure status -> message
+    splits_bitwise: bool = True  # contract rule 3 holds bit for bit
+    public: bool = True  # offered through the FMU's ``integrator`` parameter
+    scheme: tuple | None = None  # (prepare, step) of a fixed-step scheme
+
+    def supports(self, model: str) -> bool:
+        return self.models == "*" or model in self.models
+
+    def message(self, status: int, **where) -> str:
+        text = self.statuses.get(status) or (NON_FINITE_MESSAGE if status == NON_FINITE
+                                             else f"integrator {self.name} failed with status {status}")
+        return text.format(integrator=self.name, **where)
+
+
+def _fixed_step(id, name, module, **record):
+    fixed_step.SCHEMES[id] = (module.prepare, module.step)
+    return Integrator(id=id, name=name, advance=fixed_step.advance, observe=fixed_step.observe,
+                      scheme=(module.prepare, module.step), **record)
+
+
+_IMPLICIT_STATUSES = {
+    implicit_contact.TOO_MANY_SWITCHES: (
+        f"more than {implicit_contact.MAX_SEGMENTS} contact switches within one step of dt = {{dt:g}} between t = "
+        "{t:g} and t = {t_end:g} ({integrator}): the contact chatters faster than the step resolves; the state at "
+        "t = {t:g} is kept. Reduce dt."),
+    implicit_contact.TOO_FAST_FOR_CORRUGATION: (
+        "the block crosses the corrugation too fast for dt = {dt:g} between t = {t:g} and t = {t_end:g}: the "
+        f"surface under it turns by more than {implicit_contact.MAX_TURN_PER_STEP} rad in one step "
+        "({integrator}); the state at t = {t:g} is kept. Reduce dt."),
+}
+
+_RECORDS = (
+    _fixed_step(0, "symplectic_euler", symplectic_euler,
+                summary="the paper's first-order scheme (semi-implicit Euler)", models="*", force_evaluations=1,
+                check_step=_spring_dashpot_limit(1.0)),
+    _fixed_step(1, "rk4", rk4, summary="classical fourth-order Runge-Kutta", models="*", force_evaluations=4,
+                check_step=_spring_dashpot_limit(4.0)),
+    Integrator(2, "event_driven", "exact flows with located events (model A only)", models="A",
+               force_evaluations=0, check_step=_no_limit, advance=event_driven.advance,
+               observe=event_driven.observe, splits_bitwise=False),
+    _fixed_step(3, "implicit_contact", implicit_contact,
+                summary="contact spring-dashpots in closed form, stiff-stable", models="*", force_evaluations=2,
+                check_step=_implicit_contact_limit, statuses=_IMPLICIT_STATUSES),
+)
+INTEGRATOR_RECORDS: dict[str, Integrator] = {r.name: r for r in _RECORDS}
+BY_ID: dict[int, Integrator] = {r.id: r for r in _RECORDS}
+# name -> FMU id of the integrators users choose from
+INTEGRATORS: dict[str, int] = {r.name: r.id for r in _RECORDS if r.public}
+
+
+def _register_reduced_scene() -> Integrator:
+    """The scheme that runs a scene with reductions (``vibroblock.scenes``): internal,
+    chosen by the scene options, not by ``integrator``."""
+    from .. import scenes  # imports fixed_step, so it comes after this package's own modules
+    record = Integrator(scenes.SCHEME_ID, "reduced_scene", "scene reductions, first order", models="*",
+                        force_evaluations=1, check_step=_no_limit, advance=fixed_step.advance,
+                        observe=scenes.observe, public=False, scheme=(scenes.prepare, scenes.step))
+    fixed_step.SCHEMES[scenes.SCHEME_ID] = record.scheme
+    BY_ID[scenes.SCHEME_ID] = record
+    return record
+
+
+REDUCED_SCENE = _register_reduced_scene()
+
+
+def integrator(name_or_id) -> Integrator:
+    """The record of a public integrator, by name or FMU id."""
+    if isinstance(name_or_id, str):
+        record = INTEGRATOR_RECORDS.get(name_or_id)
+    else:
+        record = BY_ID.get(int(name_or_id))
+    if record is None or not record.public:
+        raise KeyError(name_or_id)
+    return record
+
+
+__all__ = ["INTEGRATORS", "INTEGRATOR_RECORDS", "BY_ID", "Integrator", "integrator", "REDUCED_SCENE", "OK", "STOP",
+           "NON_FINITE"]

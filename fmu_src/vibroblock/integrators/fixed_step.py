@@ -1,0 +1,205 @@
+"""The one fixed-step driver: every fixed-step scheme is a ``step`` function run by it.
+
+A scheme module provides two compiled functions (``symplectic_euler.py`` is the
+smallest example):
+
+``prepare(kind, flags, drv, prm, h) -> ctx``
+    what the scheme computes once per call for steps of length h (a propagator table,
+    scratch arrays, ...); any tuple.
+``step(kind, flags, ctx, prm, drv, x, z, vx, vz, F, contact0, t, h, span, plate, track_energy)``
+    one step of length h from the state at time t, whose contact quantities
+    ``contact0`` (``dynamics.contact``: penetration, u_n, u_t, cos a, sin a, N) are
+    known.  ``span`` is the step as the difference of the grid times it joins (differs
+    from h by rounding; a scheme uses one or the other, always the same).  ``plate`` is
+    (height, velocity) at t, at t + span/2 and at t + h, and the drive's (sin, cos) at
+    t + h.  Returns (status, x, z, vx, vz, F, contact1, rule_penetration, rule_normal,
+    d_phi, d_work, d_dissipated, d_normal): status 0, STOP (the step is not taken: a
+    scene's guard hands over) or a negative failure code; the contact quantities at
+    the new state; what the friction rule is to see there; and the step's increments of
+    the quadratures.
+
+The driver owns everything else: the grid and the plate drive, the friction rule and
+the quadratures at the end of every step (``settle``), the counters, the finite-state
+checks, and leaving the arrays untouched on failure (the contract in ``__init__``).
+Which scheme runs is a compile-time constant (``method``, a literal): the step is
+inlined into the loop, so the loop costs what a hand-written one would.
+"""
+import math
+
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import literally, njit, types
+from numba.extending import overload
+
+from ..dynamics import contact, friction_rule
+from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
+                      O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
+                      P_KT, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+from .plate import next_sin_cos, phase_at_time, plate_at, plate_at_time, plate_moves, drive_sin_cos
+
+OK, STOP = 0, 1
+NON_FINITE = -1
+# How often (in steps) a long run checks that the state is still finite.
+FINITE_CHECK = 1 << 16
+
+# method id -> (prepare, step), filled by the registry (``integrators.__init__``) before
+# anything is compiled.
+SCHEMES = {}
+
+
+def scheme_prepare(method):
+    """The ``prepare`` of scheme ``method`` (compiled code only)."""
+
+
+def scheme_step(method):
+    """The ``step`` of scheme ``method`` (compiled code only)."""
+
+
+@overload(scheme_prepare)
+def _scheme_prepare(method):
+    if isinstance(method, types.IntegerLiteral):
+        prepare = SCHEMES[method.literal_value][0]
+        return lambda method: prepare
+    return None
+
+
+@overload(scheme_step)
+def _scheme_step(method):
+    if isinstance(method, types.IntegerLiteral):
+        step = SCHEMES[method.literal_value][1]
+        return lambda method: step
+    return None
+
+
+@njit(inline="always")
+def kahan_add(total, compensation, value):
+    corrected = value - compensation
+    new_total = total + corrected
+    return new_total, (new_total - total) - corrected
+
+
+@njit(inline="always")
+def is_finite_state(x, z, vx, vz, shear):
+    return math.isfinite(x + z + vx + vz + shear)
+
+
+@njit(inline="always")
+def settle(prm, shear, rule_penetration, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
+           d_phi, d_work, d_dissipated, d_normal, track_energy):
+    """End of every step of every scheme: the friction rule at the new state (a reset
+    releases k_t F^2/2, counted as dissipated), then the step's quadratures."""
+    loaded = shear
+    shear, reset = friction_rule(shear, rule_penetration, rule_normal, prm)
+    phi, phi_c = kahan_add(phi, phi_c, d_phi)
+    if track_energy:
+        work += d_work
+        dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+        e_normal += d_normal
+    return shear, slips + reset, phi, phi_c, work, dissipated, e_normal
+
+
+@njit(cache=True)
+def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
+    """Advance by up to n_steps grid steps with scheme ``method``.  Returns OK, STOP (a
+    scene's guard stopped before a step; the steps taken so far are stored) or a
+    negative failure code (the arrays are left as they were on entry)."""
+    kind, method = literally(kind), literally(method)
+    prepare, step = scheme_prepare(method), scheme_step(method)
+    t0, dt = drv[D_T0], drv[D_DT]
+    ctx = prepare(kind, flags, drv, prm, dt)
+    moving = plate_moves(drv)
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
+    n, slips = cnt[C_STEP], cnt[C_SLIPS]
+    rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
+    half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
+    s, c = drive_sin_cos(drv, cnt, n)
+    t = t0 + n * dt
+    pz0, pv0 = plate_at(drv, s, c, t)
+    contact0 = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    status = OK
+    done = 0
+    while done < n_steps:
+        n1 = n + 1
+        t1 = t0 + n1 * dt
+        if moving:
+            pzh, pvh = plate_at(drv, s * half_c + c * half_s, c * half_c - s * half_s, t + 0.5 * dt)
+            s, c = next_sin_cos(drv, cnt, n1, s, c, rot_s, rot_c)
+            pz1, pv1 = plate_at(drv, s, c, t1)
+        else:
+            pzh, pvh, pz1, pv1 = pz0, pv0, pz0, pv0
+        (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
+         d_normal) = step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, dt, t1 - t,
+                          (pz0, pv0, pzh, pvh, pz1, pv1, s, c), track_energy)
+        if status != OK:
+            if status < 0:
+                return status
+            break
+        x, z, vx, vz, contact0 = x1, z1, vx1, vz1, contact1
+        shear, slips, phi, phi_c, work, dissipated, e_normal = settle(
+            prm, shear1, rule_pen, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
+            d_phi, d_work, d_dissipated, d_normal, track_energy)
+        n, t, pz0, pv0 = n1, t1, pz1, pv1
+        done += 1
+        if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
+            return NON_FINITE
+    if not is_finite_state(x, z, vx, vz, shear):
+        return NON_FINITE
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F] = x, z, vx, vz, shear
+    y[Y_PHI], y[Y_PHI_C] = phi, phi_c
+    y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
+    cnt[C_STEP], cnt[C_SLIPS] = n, slips
+    return status
+
+
+@njit(cache=True)
+def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
+    """Fill ``obs`` (``layout.O_*``) with the state at t_n + h, 0 <= h < dt, without
+    touching the stored state.
+
+    A communication point between two grid points is reached by one scratch step of
+    length h from the grid state, the plate taken exactly (not by the loop's
+    recurrence) at t_n, t_n + h/2 and t_n + h: outputs are at the requested time while
+    the stored trajectory stays on the grid, independent of the communication steps.
+    A scratch step that fails leaves the grid state (with the plate at t_n + h)."""
+    kind, method = literally(kind), literally(method)
+    prepare, step = scheme_prepare(method), scheme_step(method)
+    t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
+    x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, slips = y[Y_PHI], cnt[C_SLIPS]
+    work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
+    pz0, pv0 = plate_at_time(drv, cnt, t)
+    state_contact = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    if h > 0.0:
+        ctx = prepare(kind, flags, drv, prm, h)
+        pzh, pvh = plate_at_time(drv, cnt, t + 0.5 * h)
+        phase1 = phase_at_time(drv, cnt, t + h)
+        s1, c1 = math.sin(phase1), math.cos(phase1)
+        pz1, pv1 = plate_at(drv, s1, c1, t + h)
+        (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
+         d_normal) = step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, state_contact, t, h, h,
+                          (pz0, pv0, pzh, pvh, pz1, pv1, s1, c1), track_energy)
+        if status == OK:
+            x, z, vx, vz, shear = x1, z1, vx1, vz1, shear1
+        else:
+            d_phi = d_work = d_dissipated = d_normal = 0.0
+        state_contact = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        if status != OK:
+            rule_pen, rule_normal = state_contact[0], state_contact[5]
+        loaded = shear
+        shear, reset = friction_rule(shear, rule_pen, rule_normal, prm)
+        slips += reset
+        phi += d_phi
+        if track_energy:
+            work += d_work
+            dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+            e_normal += d_normal
+        t += h
+    pen, u_n, u_t, cos_a, sin_a, normal = state_contact
+    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = x, z, vx, vz, shear
+    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, cos_a
+    obs[O_PHI], obs[O_SLIPS], obs[O_T] = phi, slips, t
+    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = work, dissipated, e_normal
+    obs[O_CONTACT] = 1.0 if pen > 0.0 else 0.0
+    obs[O_FRICTION] = -prm[P_KT] * shear if pen > 0.0 else 0.0
+    return N_OBS

@@ -1,0 +1,70 @@
+"""``rk4`` (id 1): classical fourth-order Runge-Kutta on (x, z, vx, vz, F, phi).
+
+The contact gate Theta(delta) is evaluated inside each stage; the friction rule is the
+driver's, after the step.  Fourth order between events, first order across a contact
+switch or a reset.  Four force evaluations per step; stable while
+dt^2 k/m + 2 dt gamma/m <= 8 (imaginary axis) or ~5.6 (real axis): we ask <= 4.
+"""
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import njit
+
+from ..dynamics import contact, energy_rates, force
+from ..layout import P_M, P_VD
+
+
+@njit(inline="always")
+def prepare(kind, flags, drv, prm, h):
+    return 0
+
+
+@njit(inline="always")
+def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
+    """Accelerations, dF/dt, and the rates of the quadratures (phi, work, dissipation,
+    normal-spring energy) at one stage."""
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
+    d_shear = u_t if pen > 0.0 else 0.0
+    dv = vx - prm[P_VD]
+    work = dissipation = storage = 0.0
+    if track_energy:
+        work, dissipation, storage = energy_rates(kind, x, vx, vz, t, pen, u_n, u_t, cos_a, sin_a, normal,
+                                                  shear, plate_v, prm)
+    return fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv, work, dissipation, storage
+
+
+@njit(inline="always")
+def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, pz1, pv1, track_energy):
+    """One classical RK4 step of length h; returns the new state and the increments of
+    phi, work, dissipation and normal-spring energy."""
+    half = 0.5 * h
+    ax1, az1, df1, p1, w1, d1, e1 = _rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0, track_energy)
+    vx2, vz2 = vx + half * ax1, vz + half * az1
+    ax2, az2, df2, p2, w2, d2, e2 = _rhs(kind, prm, x + half * vx, z + half * vz, vx2, vz2,
+                                         shear + half * df1, t + half, pz_half, pv_half, track_energy)
+    vx3, vz3 = vx + half * ax2, vz + half * az2
+    ax3, az3, df3, p3, w3, d3, e3 = _rhs(kind, prm, x + half * vx2, z + half * vz2, vx3, vz3,
+                                         shear + half * df2, t + half, pz_half, pv_half, track_energy)
+    vx4, vz4 = vx + h * ax3, vz + h * az3
+    ax4, az4, df4, p4, w4, d4, e4 = _rhs(kind, prm, x + h * vx3, z + h * vz3, vx4, vz4,
+                                         shear + h * df3, t + h, pz1, pv1, track_energy)
+    sixth = h / 6.0
+    return (x + sixth * (vx + 2.0 * vx2 + 2.0 * vx3 + vx4),
+            z + sixth * (vz + 2.0 * vz2 + 2.0 * vz3 + vz4),
+            vx + sixth * (ax1 + 2.0 * ax2 + 2.0 * ax3 + ax4),
+            vz + sixth * (az1 + 2.0 * az2 + 2.0 * az3 + az4),
+            shear + sixth * (df1 + 2.0 * df2 + 2.0 * df3 + df4),
+            sixth * (p1 + 2.0 * p2 + 2.0 * p3 + p4),
+            sixth * (w1 + 2.0 * w2 + 2.0 * w3 + w4),
+            sixth * (d1 + 2.0 * d2 + 2.0 * d3 + d4),
+            sixth * (e1 + 2.0 * e2 + 2.0 * e3 + e4))
+
+
+@njit(inline="always")
+def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+    # The step is the difference of the grid times it joins (span), so that its stages
+    # sit at the times the plate was evaluated for.
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(
+        kind, prm, x, z, vx, vz, shear, t, span, pz0, pv0, pzh, pvh, pz1, pv1, track_energy)
+    contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+    return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)

@@ -1,0 +1,50 @@
+"""``symplectic_euler`` (id 0): the paper's first-order scheme, as we read it.
+
+Velocity first, then position with the new velocity (semi-implicit Euler); the shear
+displacement grows by h times the new tangential velocity while the step started in
+contact, so on a flat plate F is exactly the horizontal travel since contact began.
+First order, one force evaluation per step; stable while dt^2 k/m + 2 dt gamma/m <= 4
+for each spring-dashpot (we ask <= 1, which keeps the contact's ringing resolved).
+"""
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import njit
+
+from ..dynamics import contact, energy_rates, force
+from ..layout import P_M, P_VD
+
+
+@njit(inline="always")
+def prepare(kind, flags, drv, prm, h):
+    return 0
+
+
+@njit(inline="always")
+def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plate_v, pz1, pv1, track_energy):
+    """One semi-implicit Euler step of length h from a state whose contact quantities
+    ``contact_now`` are known; returns the new state, its contact quantities, and the
+    increments of phi, work, dissipation and normal-spring energy."""
+    pen, u_n, u_t, cos_a, sin_a, normal = contact_now
+    fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
+    d_work = d_dissipated = d_normal = 0.0
+    if track_energy:
+        work, dissipation, storage = energy_rates(kind, x, vx, vz, t, pen, u_n, u_t, cos_a, sin_a, normal,
+                                                  shear, plate_v, prm)
+        d_work, d_dissipated, d_normal = h * work, h * dissipation, h * storage
+    engaged = pen > 0.0
+    vx += h_over_m * fx
+    vz += h_over_m * fz
+    x += h * vx
+    z += h * vz
+    contact_new = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+    if engaged:
+        shear += h * contact_new[2]
+    dv = vx - prm[P_VD]
+    return x, z, vx, vz, shear, contact_new, h * dv * dv, d_work, d_dissipated, d_normal
+
+
+@njit(inline="always")
+def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
+        kind, prm, x, z, vx, vz, shear, t, h, h / prm[P_M], contact0, pv0, pz1, pv1, track_energy)
+    return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)
