@@ -153,8 +153,8 @@ class Block:
         while todo > 0:
             kernel = self.settings.kernel(self.frozen_released)
             before = int(self.cnt[L.C_STEP])
-            status = kernel.advance(self.settings.variant.kind, kernel.id, self.settings.scene_flags(self.frozen_released),
-                                    self.y, self.cnt, self.drv, self.prm, todo, self.energy_balance)
+            status = kernel.run_advance(self.settings.variant.kind, self.settings.scene_flags(self.frozen_released),
+                                        self.y, self.cnt, self.drv, self.prm, todo, self.energy_balance)
             if status < 0:
                 raise ModelError(kernel.message(status, t=self.time, t_end=t_end, dt=dt))
             todo -= int(self.cnt[L.C_STEP]) - before
@@ -192,8 +192,8 @@ class Block:
         if h < GRID_TOLERANCE * dt:  # on the grid up to rounding of the master's time
             h = 0.0
         kernel = self.settings.kernel(self.frozen_released)
-        kernel.observe(self.settings.variant.kind, kernel.id, self.settings.scene_flags(self.frozen_released),
-                       self.y, self.cnt, self.drv, self.prm, min(h, dt), self.energy_balance, self.obs)
+        kernel.run_observe(self.settings.variant.kind, self.settings.scene_flags(self.frozen_released),
+                           self.y, self.cnt, self.drv, self.prm, min(h, dt), self.energy_balance, self.obs)
         return self.obs
 
     def _stored_energy(self, obs, e_normal, t):

@@ -40,6 +40,8 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import typeof, types  # noqa: E402
+
 from . import event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
 from .fixed_step import NON_FINITE, OK, STOP
 
@@ -110,6 +112,12 @@ class Integrator:
     public: bool = True  # offered through the FMU's ``integrator`` parameter
     scheme: tuple | None = None  # (prepare, step) of a fixed-step scheme
 
+    def run_advance(self, kind: int, flags: int, y, cnt, drv, prm, n_steps: int, track_energy: bool) -> int:
+        return _specialized(self.advance, kind, self.id, (flags, y, cnt, drv, prm, n_steps, bool(track_energy)))
+
+    def run_observe(self, kind: int, flags: int, y, cnt, drv, prm, h: float, track_energy: bool, obs) -> None:
+        _specialized(self.observe, kind, self.id, (flags, y, cnt, drv, prm, float(h), bool(track_energy), obs))
+
     def supports(self, model: str) -> bool:
         return self.models == "*" or model in self.models
 
@@ -117,6 +125,23 @@ class Integrator:
         text = self.statuses.get(status) or (NON_FINITE_MESSAGE if status == NON_FINITE
                                              else f"integrator {self.name} failed with status {status}")
         return text.format(integrator=self.name, **where)
+
+
+# (kernel, kind, method) -> compiled entry point.  The kernels take kind and method as
+# literals (compile-time constants); calling the dispatcher with plain ints would make
+# numba retry the non-literal typing on every call (~0.1 s), so the specialization is
+# compiled (or loaded from the cache) once and its entry point called directly.
+_ENTRY_POINTS: dict = {}
+
+
+def _specialized(kernel, kind: int, method: int, args: tuple):
+    key = (kernel, kind, method)
+    entry = _ENTRY_POINTS.get(key)
+    if entry is None:
+        signature = (types.literal(kind), types.literal(method), *(typeof(a) for a in args))
+        kernel.compile(signature)
+        entry = _ENTRY_POINTS[key] = kernel.overloads[signature].entry_point
+    return entry(kind, method, *args)
 
 
 def _fixed_step(id, name, module, **record):
