@@ -6,7 +6,7 @@ import pytest
 from scipy.linalg import expm
 
 from vibroblock import Block, ModelError, steady_orbit
-from vibroblock.implicit_contact import oscillator_flow
+from vibroblock.integrators.implicit_contact import oscillator_flow
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 
