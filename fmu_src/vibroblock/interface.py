@@ -43,13 +43,18 @@ def _models_column(names) -> str:
 
 
 def parameter_rows():
-    """Every parameter once, in the FMU order of the first variant that has it, with the
-    variants that have it and their defaults."""
-    rows = {}
+    """Every parameter once, with the variants that have it and their defaults, in an
+    order that keeps each variant's own FMU order."""
+    order, specs, defaults = [], {}, {}
     for variant in VARIANTS.values():
+        previous = None
         for p in variant.parameters:
-            rows.setdefault(p.name, (p, {}))[1][variant.name] = p.default
-    return list(rows.values())
+            if p.name not in specs:
+                specs[p.name] = p
+                order.insert(order.index(previous) + 1 if previous else 0, p.name)
+            defaults.setdefault(p.name, {})[variant.name] = p.default
+            previous = p.name
+    return [(specs[name], defaults[name]) for name in order]
 
 
 def markdown_table() -> str:
