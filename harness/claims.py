@@ -296,12 +296,10 @@ def transition_bracket(values: Sequence[float], regimes: Sequence[str]) -> tuple
 
 
 def onset_amplitude(omega, load: float = 1.0, m: float = 1.0, k_n: float = 1.0, gamma_n: float = 0.07):
-    """A_c(omega) of the steady in-contact orbit, with the load m g (A, B) or P_l (C).
-
-    The formula of ``vibroblock.detachment_amplitude``, written here because importing the
-    core into this process makes an FMU loaded later in it refuse to run (two cores)."""
-    omega = np.asarray(omega, dtype=float)
-    return (load / m) / omega**2 * np.abs(k_n - m * omega**2 + 1j * gamma_n * omega) / k_n
+    """A_c(omega) of the steady in-contact orbit, with the load m g (A, B) or P_l (C):
+    ``vibroblock.orbits.detachment_amplitude`` with g = load / m."""
+    from vibroblock.orbits import detachment_amplitude
+    return detachment_amplitude(omega, m=m, g=load / m, k_n=k_n, gamma_n=gamma_n)
 
 
 def _observe_json(observe_settings: ObservableSettings) -> dict:
@@ -333,7 +331,7 @@ def study_c1(runner: Runner) -> Study:
         "creep_velocity": result["creep_velocity"], "creep_velocity_formula": creep,
         "stick_time": obs["stick_time_mean"], "stick_time_formula": mu_s * m * g / (k_t * creep),
         "slip_length": obs["slip_length_mean"], "slip_length_formula": mu_s * m * g / k_d,
-        "slip_count": obs["slip_count"], "regime": obs["regime"],
+        "slip_events": obs["slip_events"], "regime": obs["regime"],
     }
     settings = {"model": "A", "parameters": "scaled", **parameters, "horizon": horizon,
                 "initial": "equilibrium (plate at rest)", **_observe_json(OBSERVE_A)}
@@ -353,7 +351,7 @@ def study_c2(runner: Runner) -> Study:
                 "slip_interval": [_jsonable_float(v) for v in ds.slip_interval_mean.values],
                 "stick_time": [_jsonable_float(v) for v in ds.stick_time_mean.values],
                 "slip_length": [_jsonable_float(v) for v in ds.slip_length_mean.values],
-                "slip_count": ds.slip_count.values.tolist(), "regime": ds.regime.values.tolist()}
+                "slip_events": ds.slip_events.values.tolist(), "regime": ds.regime.values.tolist()}
     settings = {"model": "A", "parameters": "scaled", "omega": omega, "horizon": base.run.horizon,
                 "initial": "steady orbit", **_observe_json(OBSERVE_A_BURSTS)}
     return Study("C2", measured, settings)
@@ -445,7 +443,7 @@ def _onset_omega(amplitude: float, gamma_n: float, load: float = 1.0, k_n: float
 def _b_point(runner: Runner, horizon: float, observe_settings: ObservableSettings, **parameters) -> PointSettings:
     values = {**SCALED, **parameters}
     run = runner.run("B", parameters=values, horizon=horizon, output_interval=2.0,
-                     initial=InitialCondition("steady_orbit", x=VALLEY),
+                     initial=InitialCondition("steady_orbit", x_start=VALLEY),
                      start_time=_relaxed_start(VALLEY, values["V_d"]))
     return PointSettings(run=run, observe=observe_settings)
 
@@ -463,7 +461,7 @@ def study_c5(runner: Runner) -> Study:
     for amplitude, result in zip(res.b_amplitudes, results):
         obs = result["observables"]
         runs.append({"A": amplitude, "peak_acceleration_over_g": amplitude * omega**2, "regime": obs["regime"],
-                     "slip_count": obs["slip_count"], "slip_interval": obs["slip_interval_mean"],
+                     "slip_events": obs["slip_events"], "slip_interval": obs["slip_interval_mean"],
                      "slip_length": obs["slip_length_mean"], "drift_velocity": obs["drift_velocity"],
                      "contact_fraction": obs["contact_fraction"],
                      "root_distance_median": result["root_distance_median"]})
@@ -474,7 +472,7 @@ def study_c5(runner: Runner) -> Study:
     frictionless = results[-1]
     obs = frictionless["observables"]
     measured = {"omega": omega, "runs": runs, "wavelength": WAVELENGTH, "V_d": SCALED["V_d"],
-                "frictionless": {"regime": obs["regime"], "slip_count": obs["slip_count"],
+                "frictionless": {"regime": obs["regime"], "slip_events": obs["slip_events"],
                                  "slip_length": obs["slip_length_mean"],
                                  "root_distance_median": frictionless["root_distance_median"],
                                  "root_distance_p90": frictionless["root_distance_p90"]}}
@@ -489,7 +487,7 @@ def study_c5(runner: Runner) -> Study:
 
 def _c_run(runner: Runner, horizon: float, **parameters) -> RunSettings:
     values = {**SCALED, **parameters}
-    return runner.run("C", parameters=values, horizon=horizon, initial=InitialCondition("steady_orbit", x=CREST),
+    return runner.run("C", parameters=values, horizon=horizon, initial=InitialCondition("steady_orbit", x_start=CREST),
                       start_time=_relaxed_start(CREST, values["V_d"]))
 
 
@@ -571,7 +569,7 @@ def study_c6(runner: Runner) -> Study:
     measured = {
         "k_n_over_gamma_n": 1.0 / 0.07,
         "frictionless": {"regime": frictionless["observables"]["regime"],
-                         "slip_count": frictionless["observables"]["slip_count"],
+                         "slip_events": frictionless["observables"]["slip_events"],
                          "phi": frictionless["observables"]["phi"],
                          "drift_velocity": frictionless["observables"]["drift_velocity"]},
         "diagram_rows": rows, "omegas": diagram.omega.values.tolist(),

@@ -20,8 +20,30 @@ import json
 import math
 import sys
 
-from .settings import (INITIAL_STATES, INTEGRATORS, PRESETS, InitialCondition, Integration, ObservableSettings,
-                       Parameters, PointSettings, RunSettings, default_fmu)
+from pathlib import Path
+
+from .settings import (PRESETS, InitialCondition, Integration, ObservableSettings, Parameters, PointSettings,
+                       RunSettings, default_fmu)
+
+
+def _models() -> list[str]:
+    """The model variants, from the core's registry."""
+    from vibroblock.models import VARIANTS
+    return sorted(VARIANTS)
+
+
+def _choices(switch: str) -> list[str] | None:
+    """The names an FMU offers for an Integer switch, from the built model A FMU's model
+    description (None before a build: the FMU then checks the name when the run starts)."""
+    fmu = Path(default_fmu("A"))
+    if not fmu.is_file():
+        return None
+    from fmpy import read_model_description
+    from .fmu import FmuInterface
+    variable = next((v for v in read_model_description(str(fmu)).modelVariables if v.name == switch), None)
+    if variable is None:
+        return None
+    return sorted(FmuInterface.parse_choices(variable.description or ""))
 
 
 def _assignment(text: str) -> tuple[str, float]:
@@ -36,7 +58,7 @@ def _assignment(text: str) -> tuple[str, float]:
 
 def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_help: str = "run length") -> None:
     group = parser.add_argument_group("model and run")
-    group.add_argument("--model", default="A", choices=("A", "B", "C"), help="FMU of this model (default A)")
+    group.add_argument("--model", default="A", choices=_models(), help="FMU of this model (default A)")
     group.add_argument("--fmu", help="FMU file (overrides --model)")
     group.add_argument("--preset", default=None, choices=sorted(PRESETS),
                        help="starting parameter set (default: scaled for model A -- k_d = V_d = 1e-2, "
@@ -45,12 +67,14 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
                        metavar="NAME=VALUE", help="model parameter (repeatable)")
     group.add_argument("--horizon", type=float, default=horizon, help=f"{horizon_help} (default {horizon:g})")
     group.add_argument("--interval", type=float, default=1.0, help="output interval = communication step")
-    group.add_argument("--integrator", default="symplectic_euler", choices=sorted(INTEGRATORS))
+    group.add_argument("--integrator", default="symplectic_euler", choices=_choices("integrator"),
+                       help="internal integrator, as the FMU names it (default symplectic_euler)")
     group.add_argument("--dt", type=float, default=4e-4, help="internal step (default 4e-4)")
-    group.add_argument("--initial", default="steady_orbit", choices=sorted(INITIAL_STATES),
-                       help="initial condition (default steady_orbit)")
-    for name in ("x", "z", "vx", "vz"):
-        group.add_argument(f"--{name}0", type=float, default=0.0, help=f"initial {name} (where the condition uses it)")
+    group.add_argument("--initial-state", default="steady_orbit", choices=_choices("initial_state"),
+                       help="the FMU's initial_state (default steady_orbit)")
+    for name in ("x_start", "z_start", "vx_start", "vz_start"):
+        group.add_argument(f"--{name.replace('_', '-')}", type=float, default=0.0,
+                           help=f"the FMU's {name} (where the initial state uses it)")
     group = parser.add_argument_group("observables")
     group.add_argument("--transient", type=float, default=None,
                        help="discarded start of the run (of each ramp step) (default: a fifth of it)")
@@ -63,7 +87,7 @@ def _point(args) -> PointSettings:
     run = RunSettings.for_model(
         args.model, args.preset, fmu=args.fmu or default_fmu(args.model), parameters=Parameters(dict(args.parameters)),
         horizon=args.horizon, output_interval=args.interval, integration=Integration(args.integrator, args.dt),
-        initial=InitialCondition(args.initial, args.x0, args.z0, args.vx0, args.vz0))
+        initial=InitialCondition(args.initial_state, args.x_start, args.z_start, args.vx_start, args.vz_start))
     transient = args.horizon / 5 if args.transient is None else args.transient
     observe = ObservableSettings(transient=transient, window=args.window, phi_threshold=args.phi_threshold)
     return PointSettings(run, observe)

@@ -161,7 +161,7 @@ def _attributes(point: PointSettings, ramp: Ramp, values: dict, sha256: str, mod
         "kind": kind, "ramp_parameter": ramp.parameter, "ramp": json.dumps(to_jsonable(ramp)),
         "step_duration": point.run.horizon, "output_interval": point.run.output_interval,
         "fmu_path": point.run.fmu, "fmu_sha256": sha256, "model_name": model_name,
-        "integrator_name": point.run.integration.integrator, "initial_condition": point.run.initial.kind,
+        "integrator_name": point.run.integration.integrator, "initial_condition": point.run.initial.initial_state,
         "transient": observe_settings.transient,
         "window": "rest of step" if observe_settings.window is None else observe_settings.window,
         "phi_threshold": observe_settings.phi_threshold, "point_settings": canonical_json(point),

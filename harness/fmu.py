@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import tempfile
 import threading
@@ -96,6 +97,7 @@ class Variable:
     causality: str
     variability: str
     start: str | None
+    description: str = ""
 
 
 class FmuInterface:
@@ -108,7 +110,8 @@ class FmuInterface:
         self.guid = description.guid
         self.model_identifier = description.coSimulation.modelIdentifier
         self.model_name = description.modelName
-        self.variables = {v.name: Variable(v.name, v.valueReference, v.type, v.causality, v.variability, v.start)
+        self.variables = {v.name: Variable(v.name, v.valueReference, v.type, v.causality, v.variability, v.start,
+                                           v.description or "")
                           for v in description.modelVariables}
         self.parameters = {n: v for n, v in self.variables.items() if v.causality == "parameter"}
         self.outputs = tuple(n for n, v in self.variables.items() if v.causality == "output")
@@ -129,6 +132,28 @@ class FmuInterface:
             else:
                 out[name] = float(var.start)
         return out
+
+    def choices(self, name: str) -> dict[str, int]:
+        """The named values of an Integer switch (``integrator``, ``initial_state``, ...),
+        as the FMU's own description of the variable lists them ("0 = name, 1 = name")."""
+        variable = self.variables.get(name)
+        if variable is None or variable.type != "Integer":
+            return {}
+        return self.parse_choices(variable.description)
+
+    @staticmethod
+    def parse_choices(description: str) -> dict[str, int]:
+        return {label: int(value) for value, label in re.findall(r"(\d+) = (\w+)", description)}
+
+    def encode(self, name: str, value):
+        """An Integer switch given by name becomes the FMU's value for it."""
+        if not isinstance(value, str):
+            return value
+        choices = self.choices(name)
+        if value not in choices:
+            raise ValueError(f"{self.model_name}: {name} = {value!r} is not one of {sorted(choices)} "
+                             "(the FMU's model description)")
+        return choices[value]
 
     def require(self, names: Iterable[str], what: str = "variable") -> None:
         unknown = sorted(set(names) - set(self.variables))
@@ -230,7 +255,7 @@ class FmuInstance:
                    "Boolean": self._slave.setBoolean, "String": self._slave.setString}
         for kind, variables in groups.items():
             refs = [v.reference for v in variables]
-            vals = [values[v.name] for v in variables]
+            vals = [self.interface.encode(v.name, values[v.name]) for v in variables]
             if kind == "Integer":
                 vals = [int(v) for v in vals]
             elif kind == "Boolean":

@@ -221,7 +221,7 @@ class Observables:
 
     phi: float
     regime: str
-    slip_count: int
+    slip_events: int  # slips seen in the motion (not the FMU's slip_count, which counts Coulomb resets)
     stick_time_mean: float
     stick_time_std: float
     slip_interval_mean: float
@@ -244,7 +244,7 @@ class Observables:
 
 
 # Observables that vary from point to point (the rest are settings, reported as attributes).
-MEASURED = ("phi", "regime", "slip_count", "stick_time_mean", "stick_time_std", "slip_interval_mean",
+MEASURED = ("phi", "regime", "slip_events", "stick_time_mean", "stick_time_std", "slip_interval_mean",
             "slip_length_mean", "slip_length_std", "contact_fraction", "drift_velocity", "coulomb_resets",
             "window_start", "window_end")
 
@@ -256,7 +256,7 @@ def observe(ds: xr.Dataset, settings: ObservableSettings = ObservableSettings())
     drift = drift_velocity(ds, win)
     slips = window_slips(ds, win, settings)
     return Observables(
-        phi=value, regime=classify(value, settings.phi_threshold, drift, drive_velocity(ds)), slip_count=slips.count,
+        phi=value, regime=classify(value, settings.phi_threshold, drift, drive_velocity(ds)), slip_events=slips.count,
         stick_time_mean=_mean(slips.stick_times), stick_time_std=_std(slips.stick_times),
         slip_interval_mean=_mean(slips.intervals),
         slip_length_mean=_mean(slips.length), slip_length_std=_std(slips.length),

@@ -220,7 +220,7 @@ def verdict_c4(m: dict) -> Row:
 
 def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
     runs = m["runs"]
-    measured_a = "; ".join(f"A = {r['A']:g} (A w^2/g = {r['peak_acceleration_over_g']:.2g}): {r['slip_count']} slips, "
+    measured_a = "; ".join(f"A = {r['A']:g} (A w^2/g = {r['peak_acceleration_over_g']:.2g}): {r['slip_events']} slips, "
                            f"every {_fmt(r['slip_interval'])}, length {_fmt(r['slip_length'])}, drift "
                            f"{_fmt(r['drift_velocity'])}, contact {_fmt(r['contact_fraction'])}, max |x - x_(A=0)| "
                            f"{_fmt(r['max_x_difference'])}" for r in runs)
@@ -244,7 +244,7 @@ def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
         ok = distance <= ROOT_TOLERANCE * m["wavelength"]
         row_b = Row("C5b", measured_b, AGREES if ok else DISAGREES,
                     f"median distance {'<=' if ok else '>'} {ROOT_TOLERANCE:g} wavelengths")
-    measured_c = f"k_t = 0: regime {free['regime']}, {free['slip_count']} slips of {_fmt(free['slip_length'])}"
+    measured_c = f"k_t = 0: regime {free['regime']}, {free['slip_events']} slips of {_fmt(free['slip_length'])}"
     if free["regime"] == "stick_slip":
         row_c = Row("C5c", measured_c, AGREES, "stick-slip without tangential spring")
     elif free["regime"] == "stuck":
@@ -258,7 +258,7 @@ def verdict_c6(m: dict) -> list[Row]:
     rows = []
     free = m["frictionless"]
     measured = (f"k_t = 0, A = 0: regime {free['regime']}, phi {_fmt(free['phi'])}, drift {_fmt(free['drift_velocity'])}, "
-                f"{free['slip_count']} slips")
+                f"{free['slip_events']} slips")
     rows.append(Row("C6a", measured, DISAGREES if free["regime"] == "stick_slip" else AGREES,
                     f"regime {free['regime']}"))
 

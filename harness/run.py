@@ -25,7 +25,7 @@ import xarray as xr
 
 from .fmu import FmuError, FmuInstance, InstancePool
 from .observables import Observables, observe
-from .settings import INITIAL_STATES, PointSettings, RunSettings, canonical_json
+from .settings import PointSettings, RunSettings, canonical_json
 
 # What the observables read; recording only these keeps a sweep point cheap.
 POINT_OUTPUTS = ("x", "vx", "phi_integral", "contact", "slip_count")
@@ -104,10 +104,10 @@ def run_attributes(instance: FmuInstance, settings: RunSettings, values: dict) -
     attrs = {name: int(value) if isinstance(value, bool) else value for name, value in values.items()}
     attrs.update({
         "fmu_path": settings.fmu, "fmu_sha256": instance.sha256, "model_name": instance.interface.model_name,
-        "integrator_name": settings.integration.integrator, "initial_condition": settings.initial.kind,
+        "integrator_name": settings.integration.integrator, "initial_condition": settings.initial.initial_state,
         "horizon": settings.horizon, "output_interval": settings.output_interval,
         "start_time": settings.start_time, "run_settings": canonical_json(settings),
-        "initial_state_codes": json.dumps(INITIAL_STATES),
+        "initial_state_codes": json.dumps(instance.interface.choices("initial_state")),
     })
     return attrs
 

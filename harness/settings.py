@@ -26,9 +26,9 @@ PRESETS: dict[str, dict[str, float]] = {
     "scaled": {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3},
 }
 
-# The FMUs' `integrator` ids (vibroblock.INTEGRATORS; the harness does not import the core).
-INTEGRATORS = {"symplectic_euler": 0, "rk4": 1, "event_driven": 2, "implicit_contact": 3}
-INITIAL_STATES = {"equilibrium": 0, "given": 1, "steady_orbit": 2}
+# Integrators and initial states are named here as the FMU names them: the FMU's model
+# description lists its choices (``FmuInterface.choices``), and the name is checked and
+# turned into the FMU's value when the run starts.
 
 # FMU parameters owned by a settings object other than ``RunSettings.parameters``:
 # each value has exactly one place to be given.
@@ -96,8 +96,9 @@ class Integration:
     dt: float = 4e-4
 
     def __post_init__(self):
-        if self.integrator not in INTEGRATORS:
-            raise ValueError(f"integrator {self.integrator!r} is not one of {sorted(INTEGRATORS)}")
+        if not (isinstance(self.integrator, str) and self.integrator.isidentifier()):
+            raise ValueError(f"integrator {self.integrator!r} must be a name, e.g. 'symplectic_euler' (the FMU's "
+                             "description of its integrator parameter lists them)")
         if not (math.isfinite(self.dt) and self.dt > 0):
             raise ValueError(f"dt = {self.dt!r} must be a finite number > 0")
 
@@ -106,25 +107,27 @@ class Integration:
 class InitialCondition:
     """How the block starts.
 
+    The fields are the FMU's parameters of the same names.  ``initial_state``:
     ``steady_orbit`` puts the block on the steady in-contact orbit of the harmonic drive
     (the gentle start for vibrated runs); ``equilibrium`` at rest at the rest penetration
     under the plate's initial position (an impact if the plate moves); ``given`` at
-    (x, z, vx, vz).  x is used by every kind, vx and vz by ``equilibrium`` and ``given``.
+    (x_start, z_start, vx_start, vz_start).  x_start is used by every initial state,
+    vx_start and vz_start by ``equilibrium`` and ``given``.
     """
 
-    kind: str = "steady_orbit"
-    x: float = 0.0
-    z: float = 0.0
-    vx: float = 0.0
-    vz: float = 0.0
+    initial_state: str = "steady_orbit"
+    x_start: float = 0.0
+    z_start: float = 0.0
+    vx_start: float = 0.0
+    vz_start: float = 0.0
 
     def __post_init__(self):
-        if self.kind not in INITIAL_STATES:
-            raise ValueError(f"initial condition {self.kind!r} is not one of {sorted(INITIAL_STATES)}")
+        if not (isinstance(self.initial_state, str) and self.initial_state.isidentifier()):
+            raise ValueError(f"initial_state {self.initial_state!r} must be a name, e.g. 'steady_orbit' (the FMU's "
+                             "description of its initial_state parameter lists them)")
 
-    def fmu_values(self) -> dict[str, float | int]:
-        return {"initial_state": INITIAL_STATES[self.kind], "x_start": self.x, "z_start": self.z,
-                "vx_start": self.vx, "vz_start": self.vz}
+    def fmu_values(self) -> dict[str, float | str]:
+        return dataclasses.asdict(self)
 
 
 @dataclass(frozen=True)
@@ -171,7 +174,7 @@ class RunSettings:
     def fmu_values(self) -> dict[str, float | int]:
         """Values to set on the FMU besides its defaults: parameters, integration, start."""
         return {**dict(self.parameters), "dt": self.integration.dt,
-                "integrator": INTEGRATORS[self.integration.integrator], **self.initial.fmu_values()}
+                "integrator": self.integration.integrator, **self.initial.fmu_values()}
 
     def with_parameters(self, values: Mapping | None = None, **more: float) -> "RunSettings":
         return dataclasses.replace(self, parameters=self.parameters.updated(values, **more))

@@ -531,7 +531,7 @@ def assemble(grid: Grid, points: Sequence[GridPoint], results: Mapping[str, dict
     observe = base.observe
     attrs.update({
         "fmu_path": base.run.fmu, "fmu_sha256": sha256, "model_name": interface.model_name,
-        "integrator_name": base.run.integration.integrator, "initial_condition": base.run.initial.kind,
+        "integrator_name": base.run.integration.integrator, "initial_condition": base.run.initial.initial_state,
         "horizon": base.run.horizon, "output_interval": base.run.output_interval,
         "transient": observe.transient, "window": "rest of run" if observe.window is None else observe.window,
         "phi_threshold": observe.phi_threshold, "point_settings": canonical_json(base),

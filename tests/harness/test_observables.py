@@ -80,7 +80,7 @@ def test_sliding_with_the_drive_has_small_phi_and_no_slips():
     result = observe(ds, ObservableSettings(transient=1000.0))
     assert result.phi == pytest.approx(0.045, rel=0.05)  # <(0.3 sin)^2> = 0.045
     assert result.regime == SLIDING and not result.stick_slip
-    assert result.slip_count == 0 and math.isnan(result.stick_time_mean)
+    assert result.slip_events == 0 and math.isnan(result.stick_time_mean)
     assert result.drift_velocity == pytest.approx(V_D, rel=1e-3)
 
 
@@ -89,7 +89,7 @@ def test_slip_statistics_ignore_the_ringing_after_each_slip():
     ds = dataset(t, vx)
     assert vx[(t > onsets[0] + SLIP_TIME + 20) & (t < onsets[0] + SLIP_TIME + 60)].max() > 10 * V_D
     result = observe(ds, ObservableSettings(transient=0.0))
-    assert result.slip_count == 6
+    assert result.slip_events == 6
     assert result.slip_length_mean == pytest.approx(SLIP_LENGTH, rel=2e-3)
     assert result.slip_interval_mean == pytest.approx(PERIOD, abs=2 * DT)
     # A slip lasts while vx > V_d (the release velocity): a little less than SLIP_TIME.
@@ -107,7 +107,7 @@ def test_a_slip_cut_by_the_window_start_is_not_counted():
     ds = dataset(t, vx)
     settings = ObservableSettings(transient=onsets[1] + SLIP_TIME / 2)  # window opens mid-slip
     result = observe(ds, settings)
-    assert result.slip_count == 3
+    assert result.slip_events == 3
     assert result.window_start == pytest.approx(onsets[1] + SLIP_TIME / 2)
     assert result.transient == settings.transient and result.phi_threshold == settings.phi_threshold
 

@@ -14,7 +14,7 @@ from harness.report import AGREES, DISAGREES, NOT_REPRODUCED
 def c1_values(stick_time: float) -> dict:
     return {"rest_penetration": 1.0, "rest_penetration_formula": 1.0, "creep_velocity": 3.45e-4,
             "creep_velocity_formula": 3.4483e-4, "stick_time": stick_time, "stick_time_formula": 5178.6,
-            "slip_length": 49.0, "slip_length_formula": 50.0, "slip_count": 3, "regime": "stick_slip"}
+            "slip_length": 49.0, "slip_length_formula": 50.0, "slip_events": 3, "regime": "stick_slip"}
 
 
 def test_c1_verdict_follows_the_tolerance():
@@ -27,7 +27,7 @@ def test_c1_verdict_follows_the_tolerance():
 def c2_values(interval_at_a: float) -> dict:
     return {"omega": 0.25, "amplitudes": [0.0, 8.0], "peak_acceleration_over_g": [0.0, 0.5],
             "slip_interval": [5000.0, interval_at_a], "stick_time": [4600.0, interval_at_a - 400.0],
-            "slip_length": [49.0, 49.0 * interval_at_a / 5000.0], "slip_count": [3, 3],
+            "slip_length": [49.0, 49.0 * interval_at_a / 5000.0], "slip_events": [3, 3],
             "regime": ["stick_slip", "stick_slip"]}
 
 
