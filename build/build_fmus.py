@@ -9,6 +9,9 @@ complete, reproducible FMI 2.0 FMU:
   call the model rejects returns fmi2Error instead of fmi2OK (see build/status_shim.py);
 * the model description gets the ``InitialUnknowns`` section that FMI 2.0 requires
   for outputs with ``initial="calculated"`` (pythonfmu does not write it);
+* ``resources/python-environment.txt`` records the Python environment of the build
+  (the interpreter and its shared library), where the native front end looks for a
+  Python when the host is not a Python process (see build/python_runtime.c);
 * the archive is written deterministically (see ``finish_archive``).
 """
 from __future__ import annotations
@@ -16,6 +19,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import sys
+import sysconfig
 import tempfile
 import uuid
 import zipfile
@@ -50,19 +54,38 @@ def complete_model_description(xml_text: bytes) -> bytes:
     return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def finish_archive(fmu: Path) -> None:
+PYTHON_ENVIRONMENT = "resources/python-environment.txt"
+
+
+def python_environment_record() -> bytes:
+    """The build's Python environment, as the native front end reads it."""
+    library = Path(sysconfig.get_config_var("LIBDIR") or "") / (sysconfig.get_config_var("INSTSONAME") or "")
+    lines = ["# The Python environment this FMU was built with; the FMU's native front end starts it",
+             "# when the host is not a Python process.  VIBROBLOCK_PYTHON or vibroblock-python.txt",
+             "# in the FMU's top folder take precedence (see documentation/index.html).",
+             f"python = {sys.executable}"]
+    if library.is_file():
+        lines.append(f"library = {library}")
+    return ("\n".join(lines) + "\n").encode()
+
+
+def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
     """Complete the model description and make the archive reproducible.
 
     The same sources give the same bytes: members in name order with a fixed time
     stamp, no generation time, and a GUID derived from the archive's content (a master
     can tell two builds apart by it, and a result store can reuse points across
-    rebuilds of unchanged sources).
+    rebuilds of unchanged sources).  ``extra`` adds (or replaces) members.
     """
     with zipfile.ZipFile(fmu) as src:
         members = {item.filename: (item, src.read(item)) for item in src.infolist() if not item.is_dir()}
+    for name, data in (extra or {}).items():
+        item = zipfile.ZipInfo(name)
+        item.external_attr = 0o644 << 16
+        members[name] = (item, data)
     content = hashlib.sha256()
     for name in sorted(members):
-        if name != "modelDescription.xml":
+        if name not in ("modelDescription.xml", PYTHON_ENVIRONMENT):  # where it was built is not what it is
             content.update(name.encode())
             content.update(members[name][1])
     root = ElementTree.fromstring(complete_model_description(members["modelDescription.xml"][1]))
@@ -93,7 +116,7 @@ def build(name: str, dest: Path) -> Path:
     fmu = Path(fmu)
     from status_shim import wrap_fmu
     wrap_fmu(fmu)
-    finish_archive(fmu)
+    finish_archive(fmu, {PYTHON_ENVIRONMENT: python_environment_record()})
     return fmu
 
 

@@ -32,6 +32,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "python_runtime.h"
+
 /* ---- FMI 2.0 types (platform "default") -------------------------------- */
 
 typedef void*              fmi2Component;
@@ -134,7 +136,7 @@ static struct {
 #define INNER_SUFFIX "_pythonfmu.so"
 
 static char inner_path[PATH_MAX];   /* set when this library is loaded */
-static char load_error[PATH_MAX + 256];
+static char load_error[6 * PATH_MAX];
 static pthread_once_t load_once = PTHREAD_ONCE_INIT;
 
 /* Locate the inner library while the host's working directory is still the
@@ -156,6 +158,15 @@ static void load_inner_library(void)
         snprintf(load_error, sizeof load_error, "cannot determine the path of the FMU's binary");
         return;
     }
+    /* The inner library needs a Python in the process: find and start one first
+     * (python_runtime.c).  Its top folder is three levels above: binaries/linux64/. */
+    char root[PATH_MAX];
+    snprintf(root, sizeof root, "%s", inner_path);
+    for (int level = 0; level < 3; level++) {
+        char* slash = strrchr(root, '/');
+        if (slash != NULL) *slash = '\0';
+    }
+    if (!python_runtime_ready(root, load_error, sizeof load_error)) return;
     void* handle = dlopen(inner_path, RTLD_NOW | RTLD_LOCAL);
     if (handle == NULL) {
         snprintf(load_error, sizeof load_error, "cannot load %s: %s", inner_path, dlerror());
