@@ -12,6 +12,9 @@ complete, reproducible FMI 2.0 FMU:
 * ``resources/python-environment.txt`` records the Python environment of the build
   (the interpreter and its shared library), where the native front end looks for a
   Python when the host is not a Python process (see build/python_runtime.c);
+* the Block FMUs carry the physics core's kernels compiled at build time
+  (``resources/vibroblock_kernels``, see build/kernels.py), so that a first doStep
+  does not wait for numba;
 * the archive is written deterministically (see ``finish_archive``).
 """
 from __future__ import annotations
@@ -55,6 +58,7 @@ def complete_model_description(xml_text: bytes) -> bytes:
 
 
 PYTHON_ENVIRONMENT = "resources/python-environment.txt"
+KERNELS_FOLDER = "resources/vibroblock_kernels/"  # build/kernels.py
 
 
 def python_environment_record() -> bytes:
@@ -85,7 +89,8 @@ def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
         members[name] = (item, data)
     content = hashlib.sha256()
     for name in sorted(members):
-        if name not in ("modelDescription.xml", PYTHON_ENVIRONMENT):  # where it was built is not what it is
+        # Not in the GUID: where it was built, and kernels compiled for the build's CPU.
+        if name not in ("modelDescription.xml", PYTHON_ENVIRONMENT) and not name.startswith(KERNELS_FOLDER):
             content.update(name.encode())
             content.update(members[name][1])
     root = ElementTree.fromstring(complete_model_description(members["modelDescription.xml"][1]))
@@ -116,7 +121,11 @@ def build(name: str, dest: Path) -> Path:
     fmu = Path(fmu)
     from status_shim import wrap_fmu
     wrap_fmu(fmu)
-    finish_archive(fmu, {PYTHON_ENVIRONMENT: python_environment_record()})
+    extra = {PYTHON_ENVIRONMENT: python_environment_record()}
+    if name.startswith("Block"):
+        import kernels
+        extra.update(kernels.archive_members(CORE))
+    finish_archive(fmu, extra)
     return fmu
 
 
