@@ -40,9 +40,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(SOURCES))
 
 
+# A short run at the default parameters, for masters that start from the model
+# description (FMI 2.0, section 2.2.5); a master's own settings take precedence.
+DEFAULT_EXPERIMENT = {"startTime": "0", "stopTime": "100", "stepSize": "0.5"}
+
+
 def complete_model_description(xml_text: bytes) -> bytes:
-    """Add ModelStructure/InitialUnknowns listing every calculated output."""
+    """Add ModelStructure/InitialUnknowns listing every calculated output, and a DefaultExperiment."""
     root = ElementTree.fromstring(xml_text)
+    if root.find("DefaultExperiment") is None:
+        experiment = ElementTree.Element("DefaultExperiment", DEFAULT_EXPERIMENT)
+        root.insert(list(root).index(root.find("ModelVariables")), experiment)
     variables = root.find("ModelVariables")
     structure = root.find("ModelStructure")
     calculated = [str(index) for index, var in enumerate(variables, start=1)

@@ -87,7 +87,7 @@ def build_shim() -> Path:
     os.close(fd)
     try:
         result = subprocess.run(
-            [compiler, *CFLAGS, "-o", tmp_name, str(SHIM_SOURCE), str(RUNTIME_SOURCES[0]), *LIBS],
+            [compiler, *CFLAGS, "-I", str(HERE), "-o", tmp_name, str(SHIM_SOURCE), str(RUNTIME_SOURCES[0]), *LIBS],
             capture_output=True,
             text=True,
         )

@@ -14,7 +14,8 @@
  *                                                  AMP sin(OMEGA t) and its two derivatives
  *   check DIR ID GUID VR_X VR_PARAM START_VALUE   the calls FMI 2.0 requires (see check())
  *   cycles DIR ID GUID N VR_OUT                   N instantiate/step/free cycles; prints RSS
- *   multi ID:DIR:GUID ...                         all FMUs, two instances each, one process
+ *   multi ID:DIR:GUID:VR ...                      all FMUs, two instances each, one process;
+ *                                                  VR: first of plate_z, plate_v, plate_a
  *
  * Exit status 0 when everything held; failed checks are printed as "FAIL ...".
  */
@@ -261,9 +262,14 @@ static int check(int argc, char** argv)
     double bad = NAN;
     CHECK(fmu.fmi2SetReal(c, &param, 1, &bad) == ERROR, "NaN parameter");
     CHECK(fmu.fmi2GetReal(c, &param, 1, &value) == OK && value == start_value, "kept %a", value);
+    fmi2ValueReference nowhere = 999999;
+    CHECK(fmu.fmi2GetReal(c, &nowhere, 1, &value) == ERROR, "unknown value reference");
+    CHECK(fmu.fmi2SetReal(c, &out, 1, &value) == ERROR, "setting an output");
+    CHECK(fmu.fmi2GetInteger(c, &param, 1, (int[]){0}) == ERROR, "a Real read as Integer");
+    CHECK(fmu.fmi2GetReal(c, &param, 0, NULL) == OK, "nothing to read");
     CHECK(fmu.fmi2DoStep(NULL, 0.0, 0.1, 1) >= ERROR, "NULL instance");
     CHECK(fmu.fmi2GetReal(NULL, &param, 1, &value) >= ERROR, "NULL instance");
-    CHECK(errors_logged >= before + 2, "bad calls logged %d errors", errors_logged - before);
+    CHECK(errors_logged >= before + 5, "bad calls logged %d errors", errors_logged - before);
 
     initialize(&fmu, c);
     double t = 0.0, first[10], again[10];
@@ -370,12 +376,15 @@ static int multi(int argc, char** argv)
     enum { MAX = 8 };
     Fmu fmus[MAX];
     fmi2Component inst[MAX][2];
+    fmi2ValueReference plate_vr[MAX][3]; /* plate_z, plate_v, plate_a: Excitation's outputs, Blocks' inputs */
     int n = argc - 2 < MAX ? argc - 2 : MAX, excitation = -1;
     for (int i = 0; i < n; i++) {
         char* spec = strdup(argv[i + 2]);
         char* id = strtok(spec, ":");
         char* dir = strtok(NULL, ":");
         char* guid = strtok(NULL, ":");
+        char* plate = strtok(NULL, ":");
+        for (int k = 0; k < 3 && plate != NULL; k++) plate_vr[i][k] = (fmi2ValueReference)atoi(plate) + k;
         load(&fmus[i], dir, id);
         if (strcmp(id, "Excitation") == 0) excitation = i;
         for (int k = 0; k < 2; k++) {
@@ -385,15 +394,14 @@ static int multi(int argc, char** argv)
             initialize(&fmus[i], inst[i][k]);
         }
     }
-    /* The Excitation's outputs (value references 24..26) feed every Block's plate inputs (22..24). */
-    fmi2ValueReference plate_out[3] = {24, 25, 26}, plate_in[3] = {22, 23, 24};
+    /* The Excitation's outputs feed every Block's plate inputs. */
     double t = 0.0, h = 0.5;
     for (int step = 0; step < 20; step++, t += h) {
         double u[3] = {0, 0, 0};
-        if (excitation >= 0) CHECK(fmus[excitation].fmi2GetReal(inst[excitation][0], plate_out, 3, u) == OK, "get");
+        if (excitation >= 0) CHECK(fmus[excitation].fmi2GetReal(inst[excitation][0], plate_vr[excitation], 3, u) == OK, "get");
         for (int i = 0; i < n; i++)
             for (int k = 0; k < 2; k++) {
-                if (i != excitation) CHECK(fmus[i].fmi2SetReal(inst[i][k], plate_in, 3, u) == OK, "set inputs");
+                if (i != excitation) CHECK(fmus[i].fmi2SetReal(inst[i][k], plate_vr[i], 3, u) == OK, "set inputs");
                 CHECK(fmus[i].fmi2DoStep(inst[i][k], t, h, 1) == OK, "step %d", i);
             }
     }
