@@ -35,6 +35,7 @@ test: fmus
 
 benchmark: fmus
 	$(PY) -m harness.benchmarks.core_and_fmu
+	$(PY) -m harness.benchmarks.fmi_boundary
 
 clean:
 	rm -rf build/fmus build/work .cache out

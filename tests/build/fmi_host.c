@@ -17,6 +17,9 @@
  *   multi ID:DIR:GUID:VR ...                      all FMUs, two instances each, one process;
  *                                                  VR: first of plate_z, plate_v, plate_a
  *
+ *   bench DIR ID GUID H N VR...                   seconds from process start to the first doStep's
+ *                                                  end, then per doStep of H and per output read
+ *
  * Exit status 0 when everything held; failed checks are printed as "FAIL ...".
  */
 #define _GNU_SOURCE
@@ -26,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 typedef void* fmi2Component;
@@ -415,14 +419,56 @@ static int multi(int argc, char** argv)
     return failures ? 1 : 0;
 }
 
+/* ---- bench: the cost of the FMI boundary as a C master sees it ------------------- */
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static int bench(int argc, char** argv, double started)
+{
+    if (argc < 8) return 2;
+    const char *dir = argv[2], *id = argv[3], *guid = argv[4];
+    double h = strtod(argv[5], NULL);
+    int n = atoi(argv[6]), nvr = argc - 7;
+    fmi2ValueReference vr[64];
+    for (int i = 0; i < nvr && i < 64; i++) vr[i] = (fmi2ValueReference)strtoul(argv[7 + i], NULL, 10);
+    double values[64];
+    Fmu fmu;
+    load(&fmu, dir, id);
+    fmi2Component c = instantiate(&fmu, "bench", dir, guid);
+    if (c == NULL) return 1;
+    initialize(&fmu, c);
+    CHECK(fmu.fmi2DoStep(c, 0.0, h, 1) == OK, "first step");
+    printf("first_step_s %.3f\n", now() - started);
+    double t = h, step_time = 0, read_time = 0;
+    for (int k = 0; k < n; k++, t += h) {
+        double t0 = now();
+        CHECK(fmu.fmi2DoStep(c, t, h, 1) == OK, "step");
+        double t1 = now();
+        CHECK(fmu.fmi2GetReal(c, vr, (size_t)nvr, values) == OK, "read");
+        read_time += now() - t1;
+        step_time += t1 - t0;
+    }
+    printf("do_step_us %.2f\nread_us_per_output %.3f\n", 1e6 * step_time / n, 1e6 * read_time / n / nvr);
+    fmu.fmi2Terminate(c);
+    fmu.fmi2FreeInstance(c);
+    return failures ? 1 : 0;
+}
+
 int main(int argc, char** argv)
 {
+    double started = now();
     setvbuf(stdout, NULL, _IOLBF, 0);
     int status = 2;
     if (argc > 1 && strcmp(argv[1], "run") == 0) status = run(argc, argv);
     else if (argc > 1 && strcmp(argv[1], "check") == 0) status = check(argc, argv);
     else if (argc > 1 && strcmp(argv[1], "cycles") == 0) status = cycles(argc, argv);
     else if (argc > 1 && strcmp(argv[1], "multi") == 0) status = multi(argc, argv);
+    else if (argc > 1 && strcmp(argv[1], "bench") == 0) status = bench(argc, argv, started);
     if (status == 2) fprintf(stderr, "usage: see the comment at the top of fmi_host.c\n");
     return status;
 }
