@@ -15,6 +15,8 @@ complete, reproducible FMI 2.0 FMU:
 * the Block FMUs carry the physics core's kernels compiled at build time
   (``resources/vibroblock_kernels``, see build/kernels.py), so that a first doStep
   does not wait for numba;
+* ``documentation/index.html`` and ``model.png`` document the FMU (FMI 2.0, section
+  2.3; see build/documentation.py);
 * the archive is written deterministically (see ``finish_archive``).
 """
 from __future__ import annotations
@@ -129,7 +131,8 @@ def build(name: str, dest: Path) -> Path:
     fmu = Path(fmu)
     from status_shim import wrap_fmu
     wrap_fmu(fmu)
-    extra = {PYTHON_ENVIRONMENT: python_environment_record()}
+    import documentation
+    extra = {PYTHON_ENVIRONMENT: python_environment_record(), **documentation.archive_members(name)}
     if name.startswith("Block"):
         import kernels
         extra.update(kernels.archive_members(CORE))

@@ -155,6 +155,13 @@ __attribute__((constructor)) static void find_inner_library(void)
     snprintf(inner_path, sizeof inner_path, "%s%s", own, INNER_SUFFIX);
 }
 
+static void (*release_guard)(void);
+
+static void release_inner_guard(void)
+{
+    if (release_guard != NULL) release_guard();
+}
+
 static void load_inner_library(void)
 {
     if (inner_path[0] == '\0') {
@@ -185,6 +192,15 @@ static void load_inner_library(void)
     }
     INNER_FUNCTIONS(LOAD_POINTER)
     inner.handle = handle;
+    /* pythonfmu 0.7.0 keeps its interpreter guard in a static shared_ptr that both
+     * its static destructor and its unload hook release: at exit (or unload) it is
+     * released twice and the heap is corrupted, which later aborts the host
+     * ("free(): corrupted unsorted chunks").  Releasing it once, through the hook's
+     * own exported function, before either runs makes the two later releases no-ops.
+     * Handlers registered after the inner library was loaded run before its static
+     * destructors. */
+    release_guard = (void (*)(void))dlsym(handle, "finalizePythonInterpreter");
+    if (release_guard != NULL) atexit(release_inner_guard);
 }
 
 /* ---- the model's variables ------------------------------------------------ */
@@ -256,6 +272,7 @@ static void read_variables(const char* root)
 /* The inner library lives exactly as long as this one. */
 __attribute__((destructor)) static void unload_inner_library(void)
 {
+    release_inner_guard();
     if (inner.handle != NULL) dlclose(inner.handle);
 }
 

@@ -75,6 +75,8 @@ static struct {
     const char* (*PyUnicode_AsUTF8)(PyObj);
     void (*Py_DecRef)(PyObj);
     PyObj (*PySys_GetObject)(const char*);
+    PyObj (*PyObject_CallMethod)(PyObj, const char*, const char*, ...);
+    PyObj Py_None;
 } py;
 
 static int bind_api(void* handle)
@@ -83,7 +85,9 @@ static int bind_api(void* handle)
     BIND(Py_IsInitialized) BIND(Py_InitializeEx) BIND(Py_SetProgramName) BIND(Py_DecodeLocale)
     BIND(PyEval_SaveThread) BIND(PyGILState_Ensure) BIND(PyGILState_Release) BIND(PyImport_ImportModule)
     BIND(PyErr_Fetch) BIND(PyObject_Str) BIND(PyUnicode_AsUTF8) BIND(Py_DecRef) BIND(PySys_GetObject)
+    BIND(PyObject_CallMethod)
 #undef BIND
+    if ((py.Py_None = dlsym(handle, "_Py_NoneStruct")) == NULL) return 0;
     return 1;
 }
 
@@ -318,21 +322,23 @@ static int resolve(const Setting* setting, char* executable, char* library, char
 
 /* ---- start and check ------------------------------------------------------------ */
 
-/* Import the modules the core needs; 0 with a message naming the missing one. */
+/* Find the modules the core needs, without importing them (the core sets numba's
+ * cache folder before numba is first imported); 0 with a message naming the
+ * missing one. */
 static int check_modules(const char* who, char* error, size_t size)
 {
     int ok = 1;
     PyGILState gil = py.PyGILState_Ensure();
+    PyObj util = py.PyImport_ImportModule("importlib.util");
     for (size_t i = 0; ok && i < sizeof REQUIRED_MODULES / sizeof *REQUIRED_MODULES; i++) {
-        PyObj module = py.PyImport_ImportModule(REQUIRED_MODULES[i]);
-        if (module != NULL) {
-            py.Py_DecRef(module);
-            continue;
-        }
+        PyObj spec = util != NULL ? py.PyObject_CallMethod(util, "find_spec", "s", REQUIRED_MODULES[i]) : NULL;
+        int found = spec != NULL && spec != py.Py_None;
+        if (spec != NULL) py.Py_DecRef(spec);
+        if (found) continue;
         ok = 0;
         PyObj type = NULL, value = NULL, traceback = NULL;
         py.PyErr_Fetch(&type, &value, &traceback);
-        const char* reason = "unknown error";
+        const char* reason = "no module of that name on sys.path";
         PyObj text = value != NULL ? py.PyObject_Str(value) : NULL;
         if (text != NULL) {
             const char* utf8 = py.PyUnicode_AsUTF8(text);
@@ -344,13 +350,14 @@ static int check_modules(const char* who, char* error, size_t size)
             const char* utf8 = py.PyUnicode_AsUTF8(sys_prefix);
             if (utf8 != NULL) snprintf(prefix, sizeof prefix, "%s", utf8);
         }
-        append(error, size, "%s (sys.prefix %s) cannot import %s, which the FMU needs: %s. ", who, prefix,
+        append(error, size, "%s (sys.prefix %s) cannot find %s, which the FMU needs: %s. ", who, prefix,
                REQUIRED_MODULES[i], reason);
         if (text != NULL) py.Py_DecRef(text);
         if (type != NULL) py.Py_DecRef(type);
         if (value != NULL) py.Py_DecRef(value);
         if (traceback != NULL) py.Py_DecRef(traceback);
     }
+    if (util != NULL) py.Py_DecRef(util);
     py.PyGILState_Release(gil);
     return ok;
 }

@@ -81,6 +81,8 @@ def seed_cache(shipped: Path = SHIPPED_KERNELS) -> None:
 
 def install() -> None:
     """Put the locator first in numba's list (idempotent)."""
+    if not config.CACHE_DIR:  # numba was imported (by the host) before the package chose a folder
+        config.CACHE_DIR = os.environ.get("NUMBA_CACHE_DIR", "")
     locators = caching.CacheImpl._locator_classes
     if not any(cls.__name__ == CoreCacheLocator.__name__ and cls.__module__ == __name__ for cls in locators):
         locators.insert(0, CoreCacheLocator)
