@@ -8,7 +8,8 @@ export MPLBACKEND := Agg
 
 INSTALLED := $(VENV)/.installed
 FMUS := build/fmus/BlockA.fmu build/fmus/BlockB.fmu build/fmus/BlockC.fmu build/fmus/Excitation.fmu
-FMU_SOURCES := $(shell find fmu_src -name '*.py' -o -name '*.npz') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c
+FMU_SOURCES := $(shell find fmu_src -name '*.py' -o -name '*.npz') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c \
+	build/python_runtime.c build/python_runtime.h build/kernels.py build/documentation.py
 
 .PHONY: setup fmus run test benchmark clean
 
