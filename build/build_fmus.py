@@ -11,6 +11,14 @@ complete, reproducible FMI 2.0 FMU:
   call the model rejects returns fmi2Error instead of fmi2OK (see build/status_shim.py);
 * the model description gets the ``InitialUnknowns`` section that FMI 2.0 requires
   for outputs with ``initial="calculated"`` (pythonfmu does not write it);
+* ``resources/python-environment.txt`` records the Python environment of the build
+  (the interpreter and its shared library), where the native front end looks for a
+  Python when the host is not a Python process (see build/python_runtime.c);
+* the Block FMUs carry the physics core's kernels compiled at build time
+  (``resources/vibroblock_kernels``, see build/kernels.py), so that a first doStep
+  does not wait for numba;
+* ``documentation/index.html`` and ``model.png`` document the FMU (FMI 2.0, section
+  2.3; see build/documentation.py);
 * the archive is written deterministically (see ``finish_archive``).
 """
 from __future__ import annotations
@@ -18,6 +26,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import sys
+import sysconfig
 import tempfile
 import uuid
 import zipfile
@@ -62,9 +71,17 @@ def fmu_names() -> list[str]:
     return list(variant_scripts()) + scripts
 
 
+# A short run at the default parameters, for masters that start from the model
+# description (FMI 2.0, section 2.2.5); a master's own settings take precedence.
+DEFAULT_EXPERIMENT = {"startTime": "0", "stopTime": "100", "stepSize": "0.5"}
+
+
 def complete_model_description(xml_text: bytes) -> bytes:
-    """Add ModelStructure/InitialUnknowns listing every calculated output."""
+    """Add ModelStructure/InitialUnknowns listing every calculated output, and a DefaultExperiment."""
     root = ElementTree.fromstring(xml_text)
+    if root.find("DefaultExperiment") is None:
+        experiment = ElementTree.Element("DefaultExperiment", DEFAULT_EXPERIMENT)
+        root.insert(list(root).index(root.find("ModelVariables")), experiment)
     variables = root.find("ModelVariables")
     structure = root.find("ModelStructure")
     calculated = [str(index) for index, var in enumerate(variables, start=1)
@@ -79,19 +96,40 @@ def complete_model_description(xml_text: bytes) -> bytes:
     return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def finish_archive(fmu: Path) -> None:
+PYTHON_ENVIRONMENT = "resources/python-environment.txt"
+KERNELS_FOLDER = "resources/vibroblock_kernels/"  # build/kernels.py
+
+
+def python_environment_record() -> bytes:
+    """The build's Python environment, as the native front end reads it."""
+    library = Path(sysconfig.get_config_var("LIBDIR") or "") / (sysconfig.get_config_var("INSTSONAME") or "")
+    lines = ["# The Python environment this FMU was built with; the FMU's native front end starts it",
+             "# when the host is not a Python process.  VIBROBLOCK_PYTHON or vibroblock-python.txt",
+             "# in the FMU's top folder take precedence (see documentation/index.html).",
+             f"python = {sys.executable}"]
+    if library.is_file():
+        lines.append(f"library = {library}")
+    return ("\n".join(lines) + "\n").encode()
+
+
+def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
     """Complete the model description and make the archive reproducible.
 
     The same sources give the same bytes: members in name order with a fixed time
     stamp, no generation time, and a GUID derived from the archive's content (a master
     can tell two builds apart by it, and a result store can reuse points across
-    rebuilds of unchanged sources).
+    rebuilds of unchanged sources).  ``extra`` adds (or replaces) members.
     """
     with zipfile.ZipFile(fmu) as src:
         members = {item.filename: (item, src.read(item)) for item in src.infolist() if not item.is_dir()}
+    for name, data in (extra or {}).items():
+        item = zipfile.ZipInfo(name)
+        item.external_attr = 0o644 << 16
+        members[name] = (item, data)
     content = hashlib.sha256()
     for name in sorted(members):
-        if name != "modelDescription.xml":
+        # Not in the GUID: where it was built, and kernels compiled for the build's CPU.
+        if name not in ("modelDescription.xml", PYTHON_ENVIRONMENT) and not name.startswith(KERNELS_FOLDER):
             content.update(name.encode())
             content.update(members[name][1])
     root = ElementTree.fromstring(complete_model_description(members["modelDescription.xml"][1]))
@@ -129,7 +167,12 @@ def build(name: str, dest: Path) -> Path:
     fmu = Path(fmu)
     from status_shim import wrap_fmu
     wrap_fmu(fmu)
-    finish_archive(fmu)
+    import documentation
+    extra = {PYTHON_ENVIRONMENT: python_environment_record(), **documentation.archive_members(name)}
+    if name.startswith("Block"):
+        import kernels
+        extra.update(kernels.archive_members(CORE))
+    finish_archive(fmu, extra)
     return fmu
 
 

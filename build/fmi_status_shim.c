@@ -28,9 +28,12 @@
 #include <dlfcn.h>
 #include <limits.h>
 #include <pthread.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "python_runtime.h"
 
 /* ---- FMI 2.0 types (platform "default") -------------------------------- */
 
@@ -134,8 +137,10 @@ static struct {
 #define INNER_SUFFIX "_pythonfmu.so"
 
 static char inner_path[PATH_MAX];   /* set when this library is loaded */
-static char load_error[PATH_MAX + 256];
+static char load_error[6 * PATH_MAX];
 static pthread_once_t load_once = PTHREAD_ONCE_INIT;
+
+static void read_variables(const char* root);
 
 /* Locate the inner library while the host's working directory is still the
  * one this library was loaded from (dladdr may report a relative name). */
@@ -150,12 +155,29 @@ __attribute__((constructor)) static void find_inner_library(void)
     snprintf(inner_path, sizeof inner_path, "%s%s", own, INNER_SUFFIX);
 }
 
+static void (*release_guard)(void);
+
+static void release_inner_guard(void)
+{
+    if (release_guard != NULL) release_guard();
+}
+
 static void load_inner_library(void)
 {
     if (inner_path[0] == '\0') {
         snprintf(load_error, sizeof load_error, "cannot determine the path of the FMU's binary");
         return;
     }
+    /* The inner library needs a Python in the process: find and start one first
+     * (python_runtime.c).  Its top folder is three levels above: binaries/linux64/. */
+    char root[PATH_MAX];
+    snprintf(root, sizeof root, "%s", inner_path);
+    for (int level = 0; level < 3; level++) {
+        char* slash = strrchr(root, '/');
+        if (slash != NULL) *slash = '\0';
+    }
+    if (!python_runtime_ready(root, load_error, sizeof load_error)) return;
+    read_variables(root);
     void* handle = dlopen(inner_path, RTLD_NOW | RTLD_LOCAL);
     if (handle == NULL) {
         snprintf(load_error, sizeof load_error, "cannot load %s: %s", inner_path, dlerror());
@@ -170,11 +192,87 @@ static void load_inner_library(void)
     }
     INNER_FUNCTIONS(LOAD_POINTER)
     inner.handle = handle;
+    /* pythonfmu 0.7.0 keeps its interpreter guard in a static shared_ptr that both
+     * its static destructor and its unload hook release: at exit (or unload) it is
+     * released twice and the heap is corrupted, which later aborts the host
+     * ("free(): corrupted unsorted chunks").  Releasing it once, through the hook's
+     * own exported function, before either runs makes the two later releases no-ops.
+     * Handlers registered after the inner library was loaded run before its static
+     * destructors. */
+    release_guard = (void (*)(void))dlsym(handle, "finalizePythonInterpreter");
+    if (release_guard != NULL) atexit(release_inner_guard);
+}
+
+/* ---- the model's variables ------------------------------------------------ */
+
+/* Value references, types and settability from modelDescription.xml.  A get or
+ * set naming a variable that is not there, or of another type, or setting an
+ * output, makes the Python slave raise, which pythonfmu answers with fmi2Fatal
+ * and an unusable instance; such calls are refused here with fmi2Error.  An
+ * unreadable description leaves the table empty and the checks off. */
+typedef struct {
+    fmi2ValueReference vr;
+    char type;      /* 'r' Real, 'i' Integer or Enumeration, 'b' Boolean, 's' String */
+    char settable;  /* causality parameter or input */
+} Variable;
+
+static Variable* variables;
+static size_t n_variables;
+
+static void read_variables(const char* root)
+{
+    char path[PATH_MAX + 32];
+    snprintf(path, sizeof path, "%s/modelDescription.xml", root);
+    FILE* file = fopen(path, "rb");
+    if (file == NULL) return;
+    fseek(file, 0, SEEK_END);
+    long size = ftell(file);
+    fseek(file, 0, SEEK_SET);
+    char* text = size > 0 ? malloc((size_t)size + 1) : NULL;
+    if (text == NULL || fread(text, 1, (size_t)size, file) != (size_t)size) {
+        free(text);
+        fclose(file);
+        return;
+    }
+    fclose(file);
+    text[size] = '\0';
+    size_t capacity = 0, n = 0;
+    Variable* table = NULL;
+    for (char* p = strstr(text, "<ScalarVariable"); p != NULL; p = strstr(p + 1, "<ScalarVariable")) {
+        char* end = strchr(p, '>');
+        if (end == NULL) break;
+        *end = '\0';
+        char* ref = strstr(p, " valueReference=\"");
+        char* causality = strstr(p, " causality=\"");
+        Variable v = {0, 0, 0};
+        if (ref != NULL) v.vr = (fmi2ValueReference)strtoul(ref + 17, NULL, 10);
+        v.settable = causality != NULL && (strncmp(causality + 12, "parameter\"", 10) == 0 ||
+                                           strncmp(causality + 12, "input\"", 6) == 0);
+        *end = '>';
+        char* child = end + 1;
+        while (*child == ' ' || *child == '\n' || *child == '\r' || *child == '\t') child++;
+        if (strncmp(child, "<Real", 5) == 0) v.type = 'r';
+        else if (strncmp(child, "<Integer", 8) == 0 || strncmp(child, "<Enumeration", 12) == 0) v.type = 'i';
+        else if (strncmp(child, "<Boolean", 8) == 0) v.type = 'b';
+        else if (strncmp(child, "<String", 7) == 0) v.type = 's';
+        if (ref == NULL || v.type == 0) continue;
+        if (n == capacity) {
+            capacity = capacity ? 2 * capacity : 64;
+            Variable* grown = realloc(table, capacity * sizeof *table);
+            if (grown == NULL) { free(table); free(text); return; }
+            table = grown;
+        }
+        table[n++] = v;
+    }
+    free(text);
+    variables = table;
+    n_variables = n;
 }
 
 /* The inner library lives exactly as long as this one. */
 __attribute__((destructor)) static void unload_inner_library(void)
 {
+    release_inner_guard();
     if (inner.handle != NULL) dlclose(inner.handle);
 }
 
@@ -182,6 +280,8 @@ __attribute__((destructor)) static void unload_inner_library(void)
 
 typedef struct {
     fmi2Component         component;   /* the inner library's instance */
+    char*                 name;        /* instanceName, for messages from here */
+    int                   dead;        /* the inner instance answered fmi2Fatal */
     fmi2CallbackFunctions host;        /* the caller's callbacks, as given */
     fmi2CallbackFunctions given;       /* what the inner library gets; it keeps the pointer */
     fmi2Status            logged;      /* worst status logged during the current call */
@@ -238,6 +338,66 @@ static void shim_step_finished(fmi2ComponentEnvironment env, fmi2Status status)
     inst->host.stepFinished(inst->host.componentEnvironment, status);
 }
 
+/* A message from the front end itself (never printf-formatted by the host). */
+static void shim_log(Instance* inst, fmi2Status status, const char* format, ...)
+{
+    if (status > inst->logged && status <= fmi2Fatal) inst->logged = status > fmi2Error ? fmi2Error : status;
+    if (inst->host.logger == NULL) return;
+    char message[1024];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    inst->host.logger(inst->host.componentEnvironment, inst->name, status,
+                      status == fmi2Error ? "logStatusError" : "logStatusFatal", "%s", message);
+}
+
+/* After fmi2Fatal pythonfmu has released the slave: any further call would touch freed memory. */
+static fmi2Status refuse_dead(Instance* inst, const char* function)
+{
+    shim_log(inst, fmi2Error, "%s: this instance failed fatally earlier (see the previous message) and can "
+             "only be freed; instantiate a new one", function);
+    return fmi2Error;
+}
+
+static const char* type_name(char type)
+{
+    switch (type) {
+    case 'r': return "Real";
+    case 'i': return "Integer";
+    case 'b': return "Boolean";
+    default: return "String";
+    }
+}
+
+/* Every value reference names a variable of the function's type (and, to set, a
+ * parameter or input); otherwise log and refuse the whole call. */
+static int references_fit(Instance* inst, const char* function, const fmi2ValueReference vr[], size_t nvr,
+                          const void* values, char type, int set)
+{
+    if (nvr > 0 && (vr == NULL || values == NULL)) {
+        shim_log(inst, fmi2Error, "%s: %zu values asked for with a NULL array", function, nvr);
+        return 0;
+    }
+    if (n_variables == 0) return 1;
+    for (size_t i = 0; i < nvr; i++) {
+        const Variable* found = NULL;
+        for (size_t k = 0; k < n_variables && found == NULL; k++)
+            if (variables[k].vr == vr[i] && variables[k].type == type) found = &variables[k];
+        if (found == NULL) {
+            shim_log(inst, fmi2Error, "%s: value reference %u is not a %s variable of this FMU; nothing was %s",
+                     function, vr[i], type_name(type), set ? "set" : "read");
+            return 0;
+        }
+        if (set && !found->settable) {
+            shim_log(inst, fmi2Error, "%s: value reference %u is an output or local variable and cannot be set; "
+                     "nothing was set", function, vr[i]);
+            return 0;
+        }
+    }
+    return 1;
+}
+
 static fmi2Status worse(fmi2Status returned, fmi2Status logged)
 {
     if (returned > fmi2Fatal) return returned;  /* fmi2Pending is no severity */
@@ -269,12 +429,14 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     inst->given.logger = shim_logger;
     inst->given.stepFinished = inst->host.stepFinished != NULL ? shim_step_finished : NULL;
     inst->given.componentEnvironment = inst;
+    inst->name = strdup(instanceName != NULL ? instanceName : "");
 
     /* Debug logging on inside: messages of every status must pass through
      * shim_logger for the status to be seen at all. */
     inst->component = inner.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation,
                                             &inst->given, visible, fmi2True);
     if (inst->component == NULL) {
+        free(inst->name);
         free(inst);
         return NULL;
     }
@@ -289,9 +451,14 @@ void fmi2FreeInstance(fmi2Component c)
      * destroyed, and with debug logging on that crashes the host (seen when an
      * instance is freed right after fmi2Instantiate).  Nothing logged while
      * freeing is of use to the host, so logging goes off first. */
-    inner.fmi2SetDebugLogging(inst->component, fmi2False, 0, NULL);
-    inner.fmi2FreeInstance(inst->component);
+    if (!inst->dead) {
+        inner.fmi2SetDebugLogging(inst->component, fmi2False, 0, NULL);
+        inner.fmi2FreeInstance(inst->component);
+    }
+    /* else pythonfmu has released the slave's objects already, and freeing its
+     * instance would release them again: the small remainder is left alone. */
     forget_categories(inst);
+    free(inst->name);
     free(inst);
 }
 
@@ -300,6 +467,8 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 {
     Instance* inst = (Instance*)c;
     if (inst == NULL || (nCategories > 0 && categories == NULL)) return fmi2Error;
+    inst->logged = fmi2OK;
+    if (inst->dead) return refuse_dead(inst, "fmi2SetDebugLogging");
     char** copy = nCategories > 0 ? calloc(nCategories, sizeof *copy) : NULL;
     if (nCategories > 0 && copy == NULL) return fmi2Error;
     for (size_t i = 0; i < nCategories; i++) {
@@ -323,15 +492,26 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 /* Define `name` with parameter list `params`; the remaining arguments are
  * the inner call's arguments, written with `inst->component` for the instance. */
-#define FORWARD(name, params, ...)                                                \
+#define FORWARD(name, params, ...) FORWARD_IF(name, params, 1, __VA_ARGS__)
+
+/* The same, forwarding only if `admissible` holds (it logs why not). */
+#define FORWARD_IF(name, params, admissible, ...)                                 \
     fmi2Status name params                                                        \
     {                                                                             \
         Instance* inst = (Instance*)c;                                            \
         if (inst == NULL) return fmi2Error;                                       \
         inst->logged = fmi2OK;                                                    \
+        if (inst->dead) return refuse_dead(inst, #name);                          \
+        if (!(admissible)) return fmi2Error;                                      \
         fmi2Status returned = inner.name(__VA_ARGS__);                            \
+        if (returned == fmi2Fatal) inst->dead = 1;                                \
         return worse(returned, inst->logged);                                     \
     }
+
+/* Get and set: value references checked against the model description. */
+#define FORWARD_VALUES(name, type, set, params)                                   \
+    FORWARD_IF(name, params, references_fit(inst, #name, vr, nvr, value, type, set), \
+               inst->component, vr, nvr, value)
 
 FORWARD(fmi2SetupExperiment,
         (fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,
@@ -342,22 +522,22 @@ FORWARD(fmi2ExitInitializationMode, (fmi2Component c), inst->component)
 FORWARD(fmi2Terminate, (fmi2Component c), inst->component)
 FORWARD(fmi2Reset, (fmi2Component c), inst->component)
 
-FORWARD(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2GetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2GetString, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2SetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2SetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]),
-        inst->component, vr, nvr, value)
-FORWARD(fmi2SetString, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]),
-        inst->component, vr, nvr, value)
+FORWARD_VALUES(fmi2GetReal, 'r', 0,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]))
+FORWARD_VALUES(fmi2GetInteger, 'i', 0,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]))
+FORWARD_VALUES(fmi2GetBoolean, 'b', 0,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]))
+FORWARD_VALUES(fmi2GetString, 's', 0,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]))
+FORWARD_VALUES(fmi2SetReal, 'r', 1,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]))
+FORWARD_VALUES(fmi2SetInteger, 'i', 1,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]))
+FORWARD_VALUES(fmi2SetBoolean, 'b', 1,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]))
+FORWARD_VALUES(fmi2SetString, 's', 1,
+               (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]))
 
 FORWARD(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate* state), inst->component, state)
 FORWARD(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate state), inst->component, state)

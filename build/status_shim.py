@@ -49,6 +49,8 @@ from typing import Union
 
 HERE = Path(__file__).resolve().parent
 SHIM_SOURCE = HERE / "fmi_status_shim.c"
+# The shim finds and starts the Python runtime before it loads pythonfmu's binary.
+RUNTIME_SOURCES = (HERE / "python_runtime.c", HERE / "python_runtime.h")
 WORK_DIR = HERE / "work"
 
 PLATFORM = "linux64"
@@ -67,11 +69,13 @@ def inner_library_name(model_identifier: str) -> str:
 def build_shim() -> Path:
     """Compile the shim unless a build of the current source exists; return its path.
 
-    The build is named after a hash of source and flags, so editing the source
+    The build is named after a hash of sources and flags, so editing a source
     gives a fresh build.  The compiler is ``$CC`` or ``gcc``.
     """
     compiler = os.environ.get("CC", "gcc")
     key = hashlib.sha256(SHIM_SOURCE.read_bytes())
+    for source in RUNTIME_SOURCES:
+        key.update(source.read_bytes())
     key.update(" ".join((compiler, *CFLAGS, *LIBS)).encode())
     target = WORK_DIR / f"fmi_status_shim-{key.hexdigest()[:16]}.so"
     if target.is_file():
@@ -83,7 +87,7 @@ def build_shim() -> Path:
     os.close(fd)
     try:
         result = subprocess.run(
-            [compiler, *CFLAGS, "-o", tmp_name, str(SHIM_SOURCE), *LIBS],
+            [compiler, *CFLAGS, "-I", str(HERE), "-o", tmp_name, str(SHIM_SOURCE), str(RUNTIME_SOURCES[0]), *LIBS],
             capture_output=True,
             text=True,
         )

@@ -101,6 +101,8 @@ def trajectory_dataset(times: np.ndarray, rows: np.ndarray, outputs: tuple[str, 
 def run_attributes(instance: FmuInstance, settings: RunSettings, values: dict) -> dict:
     """Attributes describing a run completely (NetCDF-safe scalars and strings)."""
     # NetCDF has no boolean attributes: flags are stored as 0/1.
+    # Switches given by name are stored as the FMU's values (their names as *_name).
+    values = {name: instance.interface.encode(name, value) for name, value in values.items()}
     attrs = {name: int(value) if isinstance(value, bool) else value for name, value in values.items()}
     attrs.update({
         "fmu_path": settings.fmu, "fmu_sha256": instance.sha256, "model_name": instance.interface.model_name,

@@ -20,3 +20,27 @@ def test_calculated_outputs_are_listed_as_initial_unknowns(fmu_path):
     unknowns = {u.get("index") for u in root.find("ModelStructure/InitialUnknowns")}
     assert outputs and unknowns == outputs
     assert validate_fmu(fmu_path("A")) == []
+
+
+def test_each_fmu_documents_itself(fmu_dir):
+    """documentation/index.html (FMI 2.0, 2.3) lists every parameter with unit and default,
+    the integrators, and how to point the FMU at a Python environment; model.png is an icon."""
+    import sys
+
+    sys.path.insert(0, str(build_fmus.SOURCES))
+    from vibroblock.parameters import defaults, parameters_for
+    from vibroblock.stepping import INTEGRATORS
+
+    for name in build_fmus.FMU_NAMES:
+        with zipfile.ZipFile(fmu_dir / f"{name}.fmu") as fmu:
+            page = fmu.read("documentation/index.html").decode()
+            icon = fmu.read("model.png")
+        assert icon.startswith(b"\x89PNG") and icon[16:24] == (128).to_bytes(4, "big") * 2
+        assert "VIBROBLOCK_PYTHON" in page and "vibroblock-python.txt" in page
+        if name.startswith("Block"):
+            model = name[-1]
+            for spec in parameters_for(model):
+                assert f"<td><code>{spec.name}</code></td><td>{spec.unit}</td><td>{defaults(model)[spec.name]:g}</td>" \
+                    in page, spec.name
+            assert all(f"<code>{integrator}</code>" in page for integrator in INTEGRATORS)
+            assert "Equations" in page and "mu_s N" in page

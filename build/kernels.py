@@ -1,0 +1,108 @@
+"""Compiled kernels shipped inside the Block FMUs, so that a first doStep does not compile.
+
+Without them, the first ``doStep`` of a freshly installed FMU compiles the numba
+kernels of the physics core (about 25 s on a 2-core machine).  At build time a child
+process runs every model, integrator and scene option of the core once with an empty
+numba cache; the cache it leaves (index and data files, filed by the core's
+content-addressed locator, ``vibroblock/jitcache.py``) is packed into the FMU as
+``resources/vibroblock_kernels/``.  At run time the core copies these files into the
+host's numba cache where it has none yet, and numba uses them if they match the
+host: the same numba and Python versions and the same CPU (name and features).
+Otherwise it compiles as before and keeps its own copy.
+
+The compiled set is kept in ``build/work/kernels-<key>`` with a key of everything it
+depends on (core sources, Python, numba, llvmlite, CPU), so rebuilding an FMU reuses
+it and builds stay byte-reproducible.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+WORK_DIR = HERE / "work"
+ARCHIVE_FOLDER = "resources/vibroblock_kernels"
+
+# Runs in a child process with the core's parent folder on sys.path and an empty
+# NUMBA_CACHE_DIR.  Every configuration a master can choose goes through the same
+# calls an FMU makes (start, inputs, advance, outputs, state); a configuration the
+# core refuses is skipped.
+WARM_UP = r"""
+import itertools, sys
+import vibroblock
+from vibroblock import Block, INTEGRATORS, ModelError
+from vibroblock.models import VARIANTS, offered_by
+from vibroblock.parameters import SCENE_OPTIONS
+
+done = refused = 0
+for model in VARIANTS:
+    scenes = [{}] + [{name: True} for name, (models, _) in SCENE_OPTIONS.items() if model in offered_by(models)]
+    for integrator, energy, scene, initial in itertools.product(INTEGRATORS, (False, True), scenes, (0, 2)):
+        try:
+            block = Block(model, integrator, initial, energy, A=0.3, omega=0.5, **scene)
+            block.start(0.0)
+            block.advance_to(1.0)
+            block.set_plate_input(0.01, 0.0, 0.0)
+            block.advance_to(2.0)
+            block.outputs()
+            block.set_state(block.get_state())
+            done += 1
+        except ModelError:
+            refused += 1
+print(f"warmed up {done} configurations ({refused} refused)")
+if done == 0:
+    sys.exit("no configuration could be run")
+"""
+
+
+def _key(core: Path) -> str:
+    import llvmlite
+    import llvmlite.binding as llvm
+    import numba
+
+    digest = hashlib.sha256()
+    for path in sorted(core.rglob("*.py")):
+        digest.update(path.relative_to(core).as_posix().encode())
+        digest.update(path.read_bytes())
+    digest.update(WARM_UP.encode())
+    host = llvm.get_host_cpu_features().flatten() if hasattr(llvm, "get_host_cpu_features") else ""
+    for part in (sys.version, numba.__version__, llvmlite.__version__, platform.machine(),
+                 llvm.get_host_cpu_name(), host):
+        digest.update(str(part).encode())
+    return digest.hexdigest()[:16]
+
+
+def compile_kernels(core: Path) -> Path:
+    """The folder of compiled kernels for the core at ``core`` (compiled if not kept yet)."""
+    target = WORK_DIR / f"kernels-{_key(core)}"
+    if target.is_dir():
+        return target
+    WORK_DIR.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(dir=WORK_DIR, prefix=".kernels-"))
+    try:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(scratch / "cache"), PYTHONPATH=str(core.parent))
+        env.pop("NUMBA_DISABLE_JIT", None)
+        done = subprocess.run([sys.executable, "-c", WARM_UP], env=env, cwd=scratch,
+                              capture_output=True, text=True, timeout=1800)
+        if done.returncode != 0:
+            raise RuntimeError(f"compiling the kernels failed:\n{done.stdout}\n{done.stderr[-4000:]}")
+        os.replace(scratch / "cache", target)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    for stale in WORK_DIR.glob("kernels-*"):
+        if stale != target:
+            shutil.rmtree(stale, ignore_errors=True)
+    return target
+
+
+def archive_members(core: Path) -> dict[str, bytes]:
+    """The FMU members ``resources/vibroblock_kernels/...`` for the core at ``core``."""
+    folder = compile_kernels(core)
+    return {f"{ARCHIVE_FOLDER}/{path.relative_to(folder).as_posix()}": path.read_bytes()
+            for path in sorted(folder.rglob("*")) if path.is_file() and path.suffix in (".nbi", ".nbc")}

@@ -1,0 +1,188 @@
+"""Benchmark: first use of a freshly extracted FMU, and the cost of the FMI boundary.
+
+    python -m harness.benchmarks.fmi_boundary [--fmu-dir build/fmus] [--without-shipped-kernels]
+
+Prints side by side:
+
+1. the first doStep of BlockA.fmu extracted to a fresh folder, with an empty numba
+   cache ("cold") and again with the cache the first run left ("warm"), in a C master
+   (tests/build/fmi_host.c: process start to the end of the first doStep, Python start
+   included) and in fmpy (a child process: instantiate to the end of the first doStep).
+   ``--without-shipped-kernels`` adds the cold case with the FMU's compiled kernels
+   removed, i.e. numba compiling everything (about half a minute);
+2. at 1000 internal steps per doStep: time per doStep through the C master and fmpy
+   against the bare core doing the same work, and time per output read after each step
+   (5 outputs read in one call).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+import zipfile
+from pathlib import Path
+
+from fmpy import read_model_description
+
+ROOT = Path(__file__).resolve().parents[2]
+HOST_SOURCE = ROOT / "tests" / "build" / "fmi_host.c"
+DT = 4e-4
+PER_STEP = 1000
+OUTPUTS = ("x", "z", "vx", "vz", "friction_force")
+
+FMPY_FIRST_STEP = textwrap.dedent("""
+    import sys, time
+    from fmpy import read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    folder = sys.argv[1]
+    md = read_model_description(folder)
+    start = time.perf_counter()
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier="BlockA", instanceName="first")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    slave.doStep(0.0, 0.4)
+    print(time.perf_counter() - start)
+    slave.terminate()
+    slave.freeInstance()
+""")
+
+
+def compile_host(work: Path) -> Path:
+    exe = work / "fmi_host"
+    subprocess.run(["cc", "-O2", "-o", str(exe), str(HOST_SOURCE), "-ldl", "-lm"], check=True)
+    return exe
+
+
+def extract(fmu: Path, folder: Path, keep_kernels: bool = True) -> Path:
+    with zipfile.ZipFile(fmu) as archive:
+        archive.extractall(folder)
+    if not keep_kernels:
+        shutil.rmtree(folder / "resources" / "vibroblock_kernels", ignore_errors=True)
+    return folder
+
+
+def child_env(cache: Path) -> dict:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON") and k != "VIBROBLOCK_PYTHON"}
+    env["NUMBA_CACHE_DIR"] = str(cache)
+    return env
+
+
+def host_first_step(host, folder, md, cache) -> float:
+    done = subprocess.run([str(host), "bench", str(folder), "BlockA", md.guid, repr(PER_STEP * DT), "1", "0"],
+                          capture_output=True, text=True, env=child_env(cache), check=True)
+    return float(done.stdout.split("first_step_s")[1].split()[0])
+
+
+def fmpy_first_step(folder, cache) -> float:
+    done = subprocess.run([sys.executable, "-c", FMPY_FIRST_STEP, str(folder)], capture_output=True, text=True,
+                          env=child_env(cache), check=True)
+    return float(done.stdout.split()[-1])
+
+
+def bare_core_per_call(calls: int) -> tuple[float, float]:
+    """The core doing the same work: (one advance_to for all of it, one advance_to and
+    five output reads per 1000 steps), both per 1000 steps; best of three."""
+    from vibroblock import Block
+
+    def whole():
+        block = Block("A")
+        block.start()
+        block.advance_to(PER_STEP * DT)
+        start = time.perf_counter()
+        block.advance_to((calls + 1) * PER_STEP * DT)
+        return (time.perf_counter() - start) / calls
+
+    def chunked():
+        block = Block("A")
+        block.start()
+        block.advance_to(PER_STEP * DT)
+        start = time.perf_counter()
+        for k in range(2, calls + 2):
+            block.advance_to(k * PER_STEP * DT)
+            [block.output(name) for name in OUTPUTS]
+        return (time.perf_counter() - start) / calls
+
+    return min(whole() for _ in range(3)), min(chunked() for _ in range(3))
+
+
+def fmpy_per_call(folder, md, calls: int) -> tuple[float, float]:
+    from fmpy.fmi2 import FMU2Slave
+
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    outputs = [vr[name] for name in OUTPUTS]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=str(folder), modelIdentifier="BlockA", instanceName="bench")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    h = PER_STEP * DT
+    slave.doStep(0.0, h)
+    stepping = reading = 0.0
+    for k in range(1, calls + 1):
+        t0 = time.perf_counter()
+        slave.doStep(k * h, h)
+        t1 = time.perf_counter()
+        slave.getReal(outputs)
+        reading += time.perf_counter() - t1
+        stepping += t1 - t0
+    slave.terminate()
+    slave.freeInstance()
+    return stepping / calls, reading / calls / len(outputs)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fmu-dir", type=Path, default=ROOT / "build" / "fmus")
+    parser.add_argument("--calls", type=int, default=5000, help="doSteps per boundary measurement")
+    parser.add_argument("--without-shipped-kernels", action="store_true",
+                        help="also time a cold start with the FMU's compiled kernels removed (slow)")
+    args = parser.parse_args(argv)
+    fmu = args.fmu_dir / "BlockA.fmu"
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+
+    with tempfile.TemporaryDirectory(prefix="vibroblock-bench-") as tmp:
+        work = Path(tmp)
+        host = compile_host(work)
+        print(f"1. first doStep (1000 internal steps) of a freshly extracted BlockA.fmu, seconds")
+        print(f"   {'':34} {'C master':>9} {'fmpy':>9}")
+        rows = [("cold: empty numba cache", True, "cold"), ("warm: cache of the cold run", True, "cold")]
+        if args.without_shipped_kernels:
+            rows.append(("cold, shipped kernels removed", False, "bare"))
+        for n, (label, keep, cache_name) in enumerate(rows):
+            figures = []
+            for kind in ("host", "fmpy"):
+                cache = work / f"cache-{kind}-{cache_name}"
+                if n == 0 or not keep:
+                    shutil.rmtree(cache, ignore_errors=True)
+                folder = extract(fmu, work / f"x-{kind}-{n}", keep)
+                figures.append(host_first_step(host, folder, md, cache) if kind == "host"
+                               else fmpy_first_step(folder, cache))
+            print(f"   {label:34} {figures[0]:9.2f} {figures[1]:9.2f}")
+
+        folder = extract(fmu, work / "x-boundary")
+        done = subprocess.run([str(host), "bench", str(folder), "BlockA", md.guid, repr(PER_STEP * DT),
+                               str(args.calls), *[str(vr[name]) for name in OUTPUTS]],
+                              capture_output=True, text=True, env=child_env(work / "cache-host-cold"), check=True)
+        figures = dict(line.split() for line in done.stdout.splitlines())
+        host_step, host_read = float(figures["do_step_us"]), float(figures["read_us_per_output"])
+        fmpy_step, fmpy_read = fmpy_per_call(folder, md, args.calls)
+        bare, chunked = bare_core_per_call(args.calls)
+
+    print(f"\n2. cost of the FMI boundary at {PER_STEP} internal steps per doStep ({args.calls} doSteps), BlockA")
+    print(f"   {'':40} {'us/doStep':>10} {'vs core':>8} {'us/output read':>15}")
+    print(f"   {'bare core, one call for all steps':40} {bare * 1e6:10.2f} {1.0:8.2f} {'-':>15}")
+    print(f"   {'bare core, a Python call per doStep':40} {chunked * 1e6:10.2f} {chunked / bare:8.2f} {'-':>15}")
+    print(f"   {'C master -> FMU':40} {host_step:10.2f} {host_step / (bare * 1e6):8.2f} {host_read:15.2f}")
+    print(f"   {'fmpy -> FMU':40} {fmpy_step * 1e6:10.2f} {fmpy_step / bare:8.2f} {fmpy_read * 1e6:15.2f}")
+
+
+if __name__ == "__main__":
+    main()
