@@ -151,7 +151,7 @@ def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
     tmp_path.replace(fmu)
 
 
-def build(name: str, dest: Path) -> Path:
+def build(name: str, dest: Path, ship_kernels: bool = True) -> Path:
     from pythonfmu.builder import FmuBuilder
 
     generated = variant_scripts()
@@ -169,7 +169,7 @@ def build(name: str, dest: Path) -> Path:
     wrap_fmu(fmu)
     import documentation
     extra = {PYTHON_ENVIRONMENT: python_environment_record(), **documentation.archive_members(name)}
-    if name.startswith("Block"):
+    if name.startswith("Block") and ship_kernels:
         import kernels
         extra.update(kernels.archive_members(CORE))
     finish_archive(fmu, extra)
@@ -182,6 +182,8 @@ def main(argv=None) -> int:
     parser.add_argument("--dest", type=Path, default=DEFAULT_DEST, help="output folder")
     parser.add_argument("--sources", type=Path, default=SOURCES, help="source tree (fmu_src)")
     parser.add_argument("--list", action="store_true", help="print the FMU names and stop")
+    parser.add_argument("--without-kernels", action="store_true",
+                        help="do not ship compiled kernels (the first doStep compiles them)")
     args = parser.parse_args(argv)
     use_sources(args.sources)
     if args.list:
@@ -189,7 +191,7 @@ def main(argv=None) -> int:
         return 0
     args.dest.mkdir(parents=True, exist_ok=True)
     for name in args.names or fmu_names():
-        print(f"built {build(name, args.dest)}")
+        print(f"built {build(name, args.dest, ship_kernels=not args.without_kernels)}")
     return 0
 
 

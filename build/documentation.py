@@ -84,22 +84,25 @@ def _table(header, rows) -> str:
 
 
 def _integrators() -> list[tuple[str, str]]:
-    """(name (id), description) from the integrators' own documentation."""
-    from vibroblock import stepping
+    """(name (id), description) from the integrator registry and each integrator's module."""
+    import sys as _sys
 
-    doc = stepping.__doc__ or ""
+    from vibroblock.integrators import INTEGRATOR_RECORDS
+
     found = []
-    for name, number in stepping.INTEGRATORS.items():
-        match = re.search(rf"``{name}`` \(id {number}[^)]*\)\s*--\s*(.*?)(?:\n\s*\n|$)", doc, re.S)
-        text = " ".join(match.group(1).split()) if match else ""
-        found.append((f"<code>{name}</code> ({number})", _e(text)))
+    for record in INTEGRATOR_RECORDS.values():
+        module = _sys.modules.get(record.advance.py_func.__module__ if record.scheme is None
+                                  else record.scheme[1].py_func.__module__)
+        doc = (module.__doc__ or "").split("\n\n")
+        detail = " ".join(doc[1].split()) if len(doc) > 1 else ""
+        found.append((f"<code>{record.name}</code> ({record.id})", _e(f"{record.summary}. {detail}".strip())))
     return found
 
 
 def block_html(model: str, identifier: str) -> str:
     from vibroblock.interface import ENERGY_BALANCE, INPUTS, OUTPUTS
-    from vibroblock.models import DESCRIPTIONS
-    from vibroblock.parameters import INITIAL_STATES, SCENE_OPTIONS, defaults, parameters_for
+    from vibroblock.models import DESCRIPTIONS, defaults, offered_by, parameters_for
+    from vibroblock.parameters import INITIAL_STATES, SCENE_OPTIONS
 
     values = defaults(model)
     rows = [(f"<code>{_e(p.name)}</code>", _e(p.unit), f"{values[p.name]:g}",
@@ -110,16 +113,19 @@ def block_html(model: str, identifier: str) -> str:
                 "<br>".join(f"{i} = {_e(text)}" for i, text in INITIAL_STATES.items())),
                ("<code>energy_balance</code>", "Boolean", "false", "fixed", _e(ENERGY_BALANCE))]
     options += [(f"<code>{_e(name)}</code>", "Boolean", "false", "fixed", _e(text))
-                for name, (models, text) in SCENE_OPTIONS.items() if model in models]
+                for name, (models, text) in SCENE_OPTIONS.items() if model in offered_by(models)]
     inputs = [(f"<code>{_e(n)}</code>", _e(unit), "0", _e(text)) for n, (unit, text) in INPUTS.items()]
     outputs = [(f"<code>{_e(n)}</code>", kind, _e(unit), _e(text)) for n, (kind, unit, text) in OUTPUTS.items()]
-    surface = "" if model == "A" else " + A_x sin(omega_x x)"
+    surface = {"A": "", "B": " + A_x sin(omega_x x)", "C": " + A_x sin(omega_x x)"}.get(
+        model, f" + height(x) (vibroblock/models/model_{model.lower()}.py)")
+    load = LOADS.get(model, f"<tr><td>load</td><td>as stated in <code>vibroblock/models/model_{model.lower()}.py"
+                            "</code></td><td>always</td></tr>")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{identifier}</title><style>{STYLE}</style></head>
 <body><h1>{identifier}: {_e(DESCRIPTIONS[model])}</h1>
 <p>Spring-block friction on a vibrating plate, FMI 2.0 co-simulation. Model {model}.</p>
 <h2>Equations</h2>
-{EQUATIONS.replace("{load}", LOADS[model]).replace("{surface}", surface)}
+{EQUATIONS.replace("{load}", load).replace("{surface}", surface)}
 <h2>Parameters</h2>
 {_table(("name", "unit", "default", "variability", "meaning"), rows)}
 <p>Bad values (non-finite, non-physical, an unstable <code>dt</code>) are refused with

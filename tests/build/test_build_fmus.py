@@ -28,10 +28,10 @@ def test_each_fmu_documents_itself(fmu_dir):
     import sys
 
     sys.path.insert(0, str(build_fmus.SOURCES))
-    from vibroblock.parameters import defaults, parameters_for
-    from vibroblock.stepping import INTEGRATORS
+    from vibroblock.integrators import INTEGRATORS
+    from vibroblock.models import defaults, parameters_for
 
-    for name in build_fmus.FMU_NAMES:
+    for name in build_fmus.fmu_names():
         with zipfile.ZipFile(fmu_dir / f"{name}.fmu") as fmu:
             page = fmu.read("documentation/index.html").decode()
             icon = fmu.read("model.png")
