@@ -207,8 +207,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; a bad record, bad settings or a refused FMU call end it with a
+    one-line message on standard error and exit status 2, not a traceback."""
     args = build_parser().parse_args(argv)
-    return args.handler(args)
+    from .fmu import FmuError
+    from .records.errors import RecordError
+    try:
+        return args.handler(args)
+    except (RecordError, FmuError, ValueError, KeyError, TypeError, OSError) as exc:
+        message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+        one_line = "; ".join(line.strip() for line in message.splitlines() if line.strip()) or type(exc).__name__
+        print(f"vibroblock {args.command}: error: {one_line}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

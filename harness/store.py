@@ -32,6 +32,8 @@ import hashlib
 import json
 import os
 import tempfile
+import time
+import warnings
 from pathlib import Path
 from typing import Iterable, Mapping
 
@@ -93,11 +95,25 @@ class PointStore:
         return self.points / f"{key}.json"
 
     def load(self, key: str, inputs: Mapping) -> dict | None:
-        """The stored observables of a point, or None if it has not been computed."""
+        """The stored observables of a point, or None if it has not been computed.
+
+        A point file that cannot be read (truncated or damaged: e.g. written by a tool
+        without the atomic rename) is moved aside to ``points/damaged/`` with a warning,
+        and the point counts as not computed, so it is computed again."""
         path = self.path(key)
         if not path.is_file():
             return None
-        record = json.loads(path.read_text())
+        try:
+            record = json.loads(path.read_text())
+            record["observables"]
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            damaged = self.points / "damaged"
+            damaged.mkdir(exist_ok=True)
+            target = damaged / f"{key}.{int(time.time() * 1e6)}.json"
+            path.replace(target)
+            warnings.warn(f"point file {path} is damaged ({type(exc).__name__}: {exc}); moved to {target} and "
+                          "computed again", RuntimeWarning, stacklevel=2)
+            return None
         if record.get("inputs") != json.loads(canonical_json(inputs)):
             raise StoreMismatch(f"{path} holds a point for other inputs than those of key {key}; "
                                 "the store was edited by hand or a key collided: remove the file")

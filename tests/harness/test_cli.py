@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -58,3 +59,15 @@ def test_bad_command_lines_are_refused(capsys):
         cli.main(["run", "--set", "A"])
     assert cli.main(["sweep", "--horizon", "10"]) == 2
     assert "--grid" in capsys.readouterr().err
+
+
+def test_bad_settings_end_with_one_line_and_status_2_not_a_traceback(tmp_path):
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "harness", "run", "--set", "k_n=-1", "--horizon", "1",
+                          "--no-progress"], capture_output=True, text=True, cwd=str(Path(__file__).resolve().parents[2]))
+    assert out.returncode == 2
+    assert "Traceback" not in out.stderr
+    lines = [line for line in out.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("vibroblock run: error:") and "k_n" in lines[0]

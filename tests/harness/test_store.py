@@ -131,3 +131,20 @@ def test_a_folder_that_is_not_a_store_is_refused(tmp_path):
     (tmp_path / "notes.txt").write_text("mine")
     with pytest.raises(StoreMismatch, match="not a point store"):
         PointStore(tmp_path)
+
+
+def test_a_damaged_point_file_is_moved_aside_and_recomputed(tmp_path):
+    from harness.store import PointStore, point_key
+
+    store = PointStore(tmp_path / "store")
+    inputs = {"A": 1.0, "omega": 0.5}
+    key = point_key(inputs)
+    store.save(key, inputs, {"phi": 0.25}, 0.1)
+    assert store.load(key, inputs) == {"phi": 0.25}
+    store.path(key).write_text('{"key": "' + key + '", "inputs": {"A": 1.0')  # truncated mid-write
+    with pytest.warns(RuntimeWarning, match="damaged"):
+        assert store.load(key, inputs) is None
+    assert not store.path(key).exists()
+    assert len(list((store.points / "damaged").iterdir())) == 1
+    store.save(key, inputs, {"phi": 0.5}, 0.1)  # computed again
+    assert store.load(key, inputs) == {"phi": 0.5}
