@@ -18,6 +18,7 @@ Three layers, each usable alone:
 from __future__ import annotations
 
 import hashlib
+import re
 import os
 import shutil
 import tempfile
@@ -27,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Mapping
 
+import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2Boolean, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
@@ -96,6 +98,39 @@ class Variable:
     causality: str
     variability: str
     start: str | None
+    description: str = ""
+
+    def choices(self) -> dict[str, int]:
+        """name -> code of an Integer whose description lists its values as "0 = name: ...; 1 = name: ..."."""
+        return {label: int(code) for code, label in _CHOICE.findall(self.description or "")}
+
+    def typed(self, value):
+        """``value`` as this variable's FMI type, refusing lossy or surprising conversions:
+        an Integer takes an integral number or the name of one of its choices, a Boolean a
+        bool (or 0/1), a Real a finite or non-finite number (the FMU judges it)."""
+        if self.type == "Integer":
+            if isinstance(value, str) and value in self.choices():
+                return self.choices()[value]
+            if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_)):
+                if float(value).is_integer() and -2**31 <= value < 2**31:
+                    return int(value)
+            named = f" or one of {sorted(self.choices())}" if self.choices() else ""
+            raise ValueError(f"{self.name} is an Integer parameter and cannot take {value!r}: give a whole "
+                             f"number{named}")
+        if self.type == "Boolean":
+            if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, float, np.integer, np.floating))
+                                                      and value in (0, 1)):
+                return bool(value)
+            raise ValueError(f"{self.name} is a Boolean parameter and cannot take {value!r}: give true or false")
+        if self.type == "Real":
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise ValueError(f"{self.name} is a Real parameter and cannot take {value!r}: give a number")
+            return float(value)
+        return value
+
+
+# "0 = fixed_axes: ...; 1 = tangent_frame: ..." in an Integer's description
+_CHOICE = re.compile(r"(?:^|[;:,(]\s*)(-?\d+) = ([A-Za-z_][A-Za-z0-9_]*)")
 
 
 class FmuInterface:
@@ -108,7 +143,8 @@ class FmuInterface:
         self.guid = description.guid
         self.model_identifier = description.coSimulation.modelIdentifier
         self.model_name = description.modelName
-        self.variables = {v.name: Variable(v.name, v.valueReference, v.type, v.causality, v.variability, v.start)
+        self.variables = {v.name: Variable(v.name, v.valueReference, v.type, v.causality, v.variability, v.start,
+                                           v.description or "")
                           for v in description.modelVariables}
         self.parameters = {n: v for n, v in self.variables.items() if v.causality == "parameter"}
         self.outputs = tuple(n for n, v in self.variables.items() if v.causality == "output")
@@ -129,6 +165,13 @@ class FmuInterface:
             else:
                 out[name] = float(var.start)
         return out
+
+    def typed(self, values: Mapping[str, object]) -> dict[str, float | int | bool | str]:
+        """``values`` converted to the FMU's types (``Variable.typed``): Integer and Boolean
+        parameters given as numbers (``RunSettings.parameters`` holds floats and bools) or
+        by a choice's name come out as int and bool."""
+        self.require(values)
+        return {name: self.variables[name].typed(value) for name, value in values.items()}
 
     def require(self, names: Iterable[str], what: str = "variable") -> None:
         unknown = sorted(set(names) - set(self.variables))
