@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from pathlib import Path
 import sys
 
 from pathlib import Path
@@ -46,14 +47,43 @@ def _choices(switch: str) -> list[str] | None:
     return sorted(FmuInterface.parse_choices(variable.description or ""))
 
 
-def _assignment(text: str) -> tuple[str, float]:
+def _assignment(text: str) -> tuple[str, float | bool | str]:
+    """NAME=NUMBER, NAME=true|false (a Boolean parameter) or NAME=CHOICE (an Integer
+    parameter's value by name, e.g. formulation=tangent_frame: resolved with the FMU)."""
     name, sep, value = text.partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name or not value:
+        raise argparse.ArgumentTypeError(f"{text!r} is not NAME=NUMBER, NAME=true|false or NAME=CHOICE")
+    if value.lower() in ("true", "false"):
+        return name, value.lower() == "true"
     try:
-        if not sep or not name.strip():
-            raise ValueError
-        return name.strip(), float(value)
+        return name, float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not NAME=NUMBER") from None
+        return name, value
+
+
+def _resolve_choices(fmu: str, assignments: list) -> dict:
+    """The --set values with choice names (formulation=tangent_frame) replaced by their
+    codes, read from the FMU's description of that Integer parameter."""
+    named = {name: value for name, value in assignments if isinstance(value, str)}
+    values = dict(assignments)
+    if not named:
+        return values
+    from .fmu import FmuInterface
+    try:
+        interface = FmuInterface(Path(fmu))
+    except Exception as exc:  # no FMU there: say what could not be resolved
+        raise SystemExit(f"--set {', '.join(f'{k}={v}' for k, v in named.items())}: cannot read the FMU {fmu} "
+                         f"to resolve the names ({exc})") from None
+    for name, value in named.items():
+        variable = interface.variables.get(name)
+        if variable is None:
+            raise SystemExit(f"--set {name}={value}: {interface.model_name} has no parameter {name!r}")
+        try:
+            values[name] = variable.typed(value)
+        except ValueError as exc:
+            raise SystemExit(f"--set {name}={value}: {exc}") from None
+    return values
 
 
 def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_help: str = "run length") -> None:
@@ -64,7 +94,8 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
                        help="starting parameter set (default: scaled for model A -- k_d = V_d = 1e-2, "
                             "gamma_t = 5e-3 -- and the FMU's own (paper) values for B and C)")
     group.add_argument("--set", dest="parameters", action="append", default=[], type=_assignment,
-                       metavar="NAME=VALUE", help="model parameter (repeatable)")
+                       metavar="NAME=VALUE", help="model parameter (repeatable): a number, true/false for a Boolean, "
+                       "or an Integer's value by name, e.g. formulation=tangent_frame")
     group.add_argument("--horizon", type=float, default=horizon, help=f"{horizon_help} (default {horizon:g})")
     group.add_argument("--interval", type=float, default=1.0, help="output interval = communication step")
     group.add_argument("--integrator", default="symplectic_euler", choices=_choices("integrator"),
@@ -84,8 +115,9 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
 
 
 def _point(args) -> PointSettings:
+    fmu = args.fmu or default_fmu(args.model)
     run = RunSettings.for_model(
-        args.model, args.preset, fmu=args.fmu or default_fmu(args.model), parameters=Parameters(dict(args.parameters)),
+        args.model, args.preset, fmu=fmu, parameters=Parameters(_resolve_choices(fmu, args.parameters)),
         horizon=args.horizon, output_interval=args.interval, integration=Integration(args.integrator, args.dt),
         initial=InitialCondition(args.initial_state, args.x_start, args.z_start, args.vx_start, args.vz_start))
     transient = args.horizon / 5 if args.transient is None else args.transient

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Mapping
 
+import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2Boolean, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
@@ -99,6 +100,38 @@ class Variable:
     start: str | None
     description: str = ""
 
+    def choices(self) -> dict[str, int]:
+        """name -> code of an Integer whose description lists its values as "0 = name: ...; 1 = name: ..."."""
+        return {label: int(code) for code, label in _CHOICE.findall(self.description or "")}
+
+    def typed(self, value):
+        """``value`` as this variable's FMI type, refusing lossy or surprising conversions:
+        an Integer takes an integral number or the name of one of its choices, a Boolean a
+        bool (or 0/1), a Real a finite or non-finite number (the FMU judges it)."""
+        if self.type == "Integer":
+            if isinstance(value, str) and value in self.choices():
+                return self.choices()[value]
+            if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_)):
+                if float(value).is_integer() and -2**31 <= value < 2**31:
+                    return int(value)
+            named = f" or one of {sorted(self.choices())}" if self.choices() else ""
+            raise ValueError(f"{self.name} is an Integer parameter and cannot take {value!r}: give a whole "
+                             f"number{named}")
+        if self.type == "Boolean":
+            if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, float, np.integer, np.floating))
+                                                      and value in (0, 1)):
+                return bool(value)
+            raise ValueError(f"{self.name} is a Boolean parameter and cannot take {value!r}: give true or false")
+        if self.type == "Real":
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise ValueError(f"{self.name} is a Real parameter and cannot take {value!r}: give a number")
+            return float(value)
+        return value
+
+
+# "0 = fixed_axes: ...; 1 = tangent_frame: ..." in an Integer's description
+_CHOICE = re.compile(r"(?:^|[;:,(]\s*)(-?\d+) = ([A-Za-z_][A-Za-z0-9_]*)")
+
 
 class FmuInterface:
     """The variables of an FMU, read from its model description."""
@@ -139,11 +172,11 @@ class FmuInterface:
         variable = self.variables.get(name)
         if variable is None or variable.type != "Integer":
             return {}
-        return self.parse_choices(variable.description)
+        return variable.choices()
 
     @staticmethod
     def parse_choices(description: str) -> dict[str, int]:
-        return {label: int(value) for value, label in re.findall(r"(\d+) = (\w+)", description)}
+        return {label: int(code) for code, label in _CHOICE.findall(description or "")}
 
     def encode(self, name: str, value):
         """An Integer switch given by name becomes the FMU's value for it."""
@@ -154,6 +187,13 @@ class FmuInterface:
             raise ValueError(f"{self.model_name}: {name} = {value!r} is not one of {sorted(choices)} "
                              "(the FMU's model description)")
         return choices[value]
+
+    def typed(self, values: Mapping[str, object]) -> dict[str, float | int | bool | str]:
+        """``values`` converted to the FMU's types (``Variable.typed``): Integer and Boolean
+        parameters given as numbers (``RunSettings.parameters`` holds floats and bools) or
+        by a choice's name come out as int and bool."""
+        self.require(values)
+        return {name: self.variables[name].typed(value) for name, value in values.items()}
 
     def require(self, names: Iterable[str], what: str = "variable") -> None:
         unknown = sorted(set(names) - set(self.variables))

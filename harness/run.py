@@ -36,7 +36,10 @@ PROGRESS_CHUNK = 500
 def resolved_parameters(instance: FmuInstance, settings: RunSettings) -> dict[str, float | int]:
     """All FMU parameter values of a run: the FMU's defaults overridden by the settings."""
     instance.interface.require(settings.parameters, "parameter")
-    return {**instance.interface.defaults(), **settings.fmu_values()}
+    try:
+        return {**instance.interface.defaults(), **instance.interface.typed(settings.fmu_values())}
+    except ValueError as exc:
+        raise ValueError(f"{settings.fmu}: {exc}") from None
 
 
 @contextlib.contextmanager

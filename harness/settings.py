@@ -17,6 +17,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from .fmu import REPO_ROOT
 
 # Parameter sets a run can start from.  "scaled" keeps model A quasi-static while making a
@@ -41,7 +43,12 @@ def default_fmu(model: str) -> str:
 
 
 class Parameters(Mapping):
-    """An immutable, hashable name -> float mapping (model parameters of a run)."""
+    """An immutable, hashable name -> value mapping (model parameters of a run).
+
+    Values are floats, except booleans, which stay bool (the FMUs' Boolean parameters,
+    e.g. the scene options).  Integer parameters (e.g. ``formulation``) are held as
+    floats like every number and reach the FMU as int, checked to be whole
+    (``harness.fmu.FmuInterface.typed``)."""
 
     __slots__ = ("_items",)
 
@@ -51,10 +58,13 @@ class Parameters(Mapping):
         for name, value in merged.items():
             if not isinstance(name, str) or not name:
                 raise TypeError(f"parameter names are non-empty strings, not {name!r}")
+            if isinstance(value, (bool, np.bool_)):
+                items.append((name, bool(value)))
+                continue
             try:
                 number = float(value)
             except (TypeError, ValueError):
-                raise TypeError(f"parameter {name} = {value!r} is not a number") from None
+                raise TypeError(f"parameter {name} = {value!r} is not a number or a bool") from None
             items.append((name, number))
         self._items = tuple(sorted(items))
 

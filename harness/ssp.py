@@ -146,6 +146,15 @@ def _type_element(parent: ET.Element, prefix: str, kind: str, value: Value | Non
     ET.SubElement(parent, _q(prefix, kind), attributes)
 
 
+def _as_type(kind: str, value: Value) -> Value:
+    """An Integer given as a whole float (``RunSettings.parameters`` holds numbers as floats)
+    is that int; every other value is checked as it is."""
+    if (kind == "Integer" and isinstance(value, (float, np.floating)) and math.isfinite(value)
+            and float(value).is_integer()):
+        return int(value)
+    return value
+
+
 def _check_value(component: Component, name: str, variable, value: Value) -> None:
     kind = variable.type
     ok = {"Real": isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
@@ -211,6 +220,7 @@ def write_ssp(path: str | os.PathLike, system: System) -> Path:
                 if name not in variables[component.name]:
                     raise SspError(f"{component.name} has no parameter {name!r}")
                 variable = variables[component.name][name]
+                value = _as_type(variable.type, value)
                 _check_value(component, name, variable, value)
                 xml_parameter = ET.SubElement(parameters, _q("ssv", "Parameter"), {"name": name})
                 _type_element(xml_parameter, "ssv", variable.type, value)

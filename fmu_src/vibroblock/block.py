@@ -12,7 +12,7 @@ import numpy as np
 
 from . import interface
 from . import layout as L
-from .initial_state import place
+from .initial_state import frame_to_point, place
 from .settings import ModelError, Settings
 
 OUTPUTS = tuple(interface.OUTPUTS)
@@ -52,6 +52,7 @@ class Block:
     initial_state = property(lambda self: self.settings.initial_state)
     energy_balance = property(lambda self: self.settings.energy_balance)
     scene = property(lambda self: self.settings.scene)
+    readings = property(lambda self: self.settings.readings)
 
     def set_parameter(self, name: str, value: float) -> None:
         self.settings.set_parameter(name, value)
@@ -66,6 +67,9 @@ class Block:
 
     def set_energy_balance(self, track: bool) -> None:
         self.settings.set_energy_balance(track)
+
+    def set_reading(self, name: str, value: int | str) -> None:
+        self.settings.set_reading(name, value)
 
     def set_scene_option(self, name: str, enabled: bool) -> None:
         self.settings.set_scene_option(name, enabled)
@@ -153,7 +157,7 @@ class Block:
         while todo > 0:
             kernel = self.settings.kernel(self.frozen_released)
             before = int(self.cnt[L.C_STEP])
-            status = kernel.run_advance(self.settings.variant.kind, self.settings.scene_flags(self.frozen_released),
+            status = kernel.run_advance(self.settings.kind, self.settings.scene_flags(self.frozen_released),
                                         self.y, self.cnt, self.drv, self.prm, todo, self.energy_balance)
             if status < 0:
                 raise ModelError(kernel.message(status, t=self.time, t_end=t_end, dt=dt))
@@ -192,12 +196,13 @@ class Block:
         if h < GRID_TOLERANCE * dt:  # on the grid up to rounding of the master's time
             h = 0.0
         kernel = self.settings.kernel(self.frozen_released)
-        kernel.run_observe(self.settings.variant.kind, self.settings.scene_flags(self.frozen_released),
+        kernel.run_observe(self.settings.kind, self.settings.scene_flags(self.frozen_released),
                            self.y, self.cnt, self.drv, self.prm, min(h, dt), self.energy_balance, self.obs)
         return self.obs
 
     def _stored_energy(self, obs, e_normal, t):
-        """Kinetic + drive spring + tangential spring + normal spring energy."""
+        """Kinetic + drive spring + tangential spring + normal spring energy (in the tangent
+        frame the kinetic energy is m (u^2 + w^2) / 2, from the state's own slots)."""
         p = self.parameters
         x, vx, vz, shear = obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F]
         stretch = x - p["V_d"] * t
@@ -212,21 +217,35 @@ class Block:
             if self.energy_balance:
                 stored = self._stored_energy(obs, obs[L.O_E_NORMAL], obs[L.O_T])
                 residual = stored - self.y[L.Y_E_START] - obs[L.O_WORK] + obs[L.O_DISSIPATED]
-            pen, z = obs[L.O_PENETRATION], obs[L.O_Z]
+            pen, x, z, vx, vz = obs[L.O_PENETRATION], obs[L.O_X], obs[L.O_Z], obs[L.O_VX], obs[L.O_VZ]
+            surface_z = z + pen / obs[L.O_COS]
+            if self.settings.kind != self.settings.variant.kind:  # a reading other than the default
+                surface_z, z, vx, vz = self._as_point(x, z, vx, vz, pen)
             self._observed = {
-                "x": float(obs[L.O_X]), "z": float(z), "vx": float(obs[L.O_VX]), "vz": float(obs[L.O_VZ]),
+                "x": float(x), "z": float(z), "vx": float(vx), "vz": float(vz),
                 "friction_force": float(obs[L.O_FRICTION]),
                 "normal_force": float(obs[L.O_NORMAL]),
                 "contact": bool(obs[L.O_CONTACT] != 0.0),
                 "slip_count": int(obs[L.O_SLIPS]),
                 "phi_integral": float(obs[L.O_PHI]),
                 "penetration": float(pen),
-                "surface_z": float(z + pen / obs[L.O_COS]),
+                "surface_z": float(surface_z),
                 "work_input": float(obs[L.O_WORK]),
                 "energy_dissipated": float(obs[L.O_DISSIPATED]),
                 "energy_residual": float(residual),
             }
         return self._observed
+
+    def _as_point(self, x, z, vx, vz, pen):
+        """Surface height under the block and the block as a point (z, vx, vz).  In the
+        tangent frame the state (x, zeta, u, w) maps to z = h + zeta / cos a etc.
+        (docs/physics.md, Sec. 4) and the plate surface under the block is at normal
+        coordinate P = zeta + delta; in fixed axes the state is the point already."""
+        height, slope = self.settings.variant.profile(x, self.prm)
+        secant = math.sqrt(1.0 + slope * slope)  # 1 / cos a
+        if self.settings.tangent_frame:
+            z, vx, vz = frame_to_point(self.settings.variant, self.prm, x, z, vx, vz)
+        return z + pen * secant, z, vx, vz
 
     @property
     def grid_step(self) -> int:

@@ -17,6 +17,21 @@ the Cundall-Strack shear displacement, dF/dt = u_t while in contact.  Projected 
 and n these are the paper's Eqs. (3)-(6); with a flat plate (a = 0) they are Eqs. (1)-(2)
 exactly.  N may be negative while the dashpot pulls the separating block: the paper's
 Heaviside factors gate on penetration only, and we follow them literally.
+
+That is the default reading (``formulation = 0``, fixed axes).  The run's readings are
+compile-time constants of ``kind`` (``vibroblock.readings``); the functions below branch
+on them and the default's branches are the only ones compiled into its kernels:
+
+* ``tangent_frame``: the paper's Eqs. (3)-(6) as printed (docs/physics.md, Sec. 4).
+  The state slots (x, z, vx, vz) hold (x, zeta, u, w): the foot's abscissa, the normal
+  coordinate, the tangential and the normal rate.  delta = P(t) - zeta, u_n = w - P'(t),
+  u_t = u; "fx, fz" are the forces along the local tangent and normal; the position
+  moves by (u cos a, w) (``position_rates``).  Outputs map to a point in ``Block``.
+* ``applied_load``: the Coulomb bound's N is N_a = -(load + drive spring) . n
+  (``coulomb_bound``), the drivers' friction rule sees it instead of the contact force.
+* ``free_flight`` (fixed axes): off contact the block is a free particle of Eqs. (1)-(2):
+  ``contact`` hands the forces the fixed axes as its frame (cos a = 1, sin a = 0,
+  u_t = vx), so the load is vertical and the dashpot acts on vx.
 """
 import math
 
@@ -25,6 +40,7 @@ from numba import njit
 
 from .layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_MUS, P_VD
 from .models import load, profile
+from .readings import applied_load, free_flight, tangent_frame
 
 
 @njit(inline="always")
@@ -44,11 +60,33 @@ def contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     else:
         cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
         sin_a = slope * cos_a
+    if tangent_frame(kind):  # state (x, zeta, u, w): the plate moves along the local normal
+        penetration = plate_z - z
+        u_n = vz - plate_v
+        return penetration, u_n, vx, cos_a, sin_a, normal_force(penetration, u_n, prm)
     penetration = (plate_z + height - z) * cos_a
     rel_vz = vz - plate_v
     u_n = rel_vz * cos_a - vx * sin_a
     u_t = vx * cos_a + rel_vz * sin_a
+    if free_flight(kind) and not penetration > 0.0:  # a free particle: the fixed axes are its frame
+        return penetration, u_n, vx, 1.0, 0.0, 0.0
     return penetration, u_n, u_t, cos_a, sin_a, normal_force(penetration, u_n, prm)
+
+
+@njit(inline="always")
+def position_rates(kind, vx, vz, cos_a):
+    """Rates of the position slots: (vx, vz) for a point; (u cos a, w) in the tangent frame,
+    whose foot advances along the surface at the tangential rate u."""
+    if tangent_frame(kind):
+        return vx * cos_a, vz
+    return vx, vz
+
+
+@njit(inline="always")
+def frame_load(kind, cos_a, sin_a, prm):
+    """The load's components along the local tangent and normal, (L.t, L.n)."""
+    load_x, load_z = load(kind, cos_a, sin_a, prm)
+    return load_x * cos_a + load_z * sin_a, load_z * cos_a - load_x * sin_a
 
 
 @njit(inline="always")
@@ -57,6 +95,10 @@ def force(kind, x, t, penetration, normal, u_t, cos_a, sin_a, shear, prm):
     tangential = -prm[P_GT] * u_t
     if penetration > 0.0:
         tangential -= prm[P_KT] * shear
+    if tangent_frame(kind):  # along the local tangent and normal (Eqs. 3-6)
+        stretch = prm[P_KD] * (x - prm[P_VD] * t)
+        load_t, load_n = frame_load(kind, cos_a, sin_a, prm)
+        return -stretch * cos_a + tangential + load_t, normal + stretch * sin_a + load_n
     load_x, load_z = load(kind, cos_a, sin_a, prm)
     fx = -prm[P_KD] * (x - prm[P_VD] * t) - normal * sin_a + tangential * cos_a + load_x
     fz = normal * cos_a + tangential * sin_a + load_z
@@ -72,7 +114,9 @@ def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal
     With kinetic energy K, drive-spring energy k_d (x - V_d t)^2 / 2 and tangential
     spring energy k_t F^2 / 2, Newton's law gives
     d(K + E_drive + E_normal + E_shear)/dt = work rate - dissipation rate, exactly;
-    the energy a reset releases (k_t F^2 / 2) counts as dissipated.
+    the energy a reset releases (k_t F^2 / 2) counts as dissipated.  In the tangent
+    frame K = m (u^2 + w^2) / 2 and the normal components of load and drive spring work
+    on zeta; the balance is again exact.
     """
     tangential = -prm[P_GT] * u_t
     dissipation = prm[P_GT] * u_t * u_t
@@ -81,11 +125,39 @@ def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal
         tangential -= prm[P_KT] * shear
         dissipation += prm[P_GN] * u_n * u_n
         storage = -prm[P_KN] * penetration * u_n
+    if tangent_frame(kind):  # the normal components of load and drive work on zeta (docs/physics.md, Sec. 7)
+        load_t, load_n = frame_load(kind, cos_a, sin_a, prm)
+        work = (prm[P_KD] * (prm[P_VD] * t - x) * prm[P_VD] + normal * plate_v + load_t * vx
+                + (load_n + prm[P_KD] * (x - prm[P_VD] * t) * sin_a) * vz)
+        return work, dissipation, storage
     load_x, load_z = load(kind, cos_a, sin_a, prm)
     work = (prm[P_KD] * (prm[P_VD] * t - x) * prm[P_VD]
             + plate_v * (normal * cos_a + tangential * sin_a)
             + load_x * vx + load_z * vz)
     return work, dissipation, storage
+
+
+@njit(inline="always")
+def applied_normal(kind, x, t, prm):
+    """N_a = -(load + drive spring) . n at abscissa x and time t: m g (A),
+    m g cos a - k_d (x - V_d t) sin a (B), P_l - k_d (x - V_d t) sin a (C)."""
+    slope = profile(kind, x, prm)[1]
+    if slope == 0.0:
+        cos_a, sin_a = 1.0, 0.0
+    else:
+        cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
+        sin_a = slope * cos_a
+    load_x, load_z = load(kind, cos_a, sin_a, prm)
+    return load_x * sin_a - load_z * cos_a - prm[P_KD] * (x - prm[P_VD] * t) * sin_a
+
+
+@njit(inline="always")
+def coulomb_bound(kind, normal, x, t, prm):
+    """The N of the Coulomb bound mu_s N at the block's abscissa x and time t: the contact
+    force ``normal`` (coulomb_normal = 0), or the applied load N_a (coulomb_normal = 1)."""
+    if applied_load(kind):
+        return applied_normal(kind, x, t, prm)
+    return normal
 
 
 @njit(inline="always")

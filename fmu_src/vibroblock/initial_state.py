@@ -25,6 +25,9 @@ def place(settings: Settings, prm, drv, y) -> bool:
     load_x, load_z = variant.load(cos_a, sin_a, prm)
     weight = max(0.0, -(-load_x * sin_a + load_z * cos_a))
     y[L.Y_X], y[L.Y_VX] = x, p["vx_start"]
+    if settings.tangent_frame:
+        _place_in_tangent_frame(settings, prm, y, weight, phase)
+        return _place_for_scene(settings, prm, drv, y)
     if settings.initial_state == 0:
         y[L.Y_Z] = plate_z - weight / (p["k_n"] * cos_a)
         y[L.Y_VZ] = p["vz_start"]
@@ -34,6 +37,45 @@ def place(settings: Settings, prm, drv, y) -> bool:
         offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
         y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
     return _place_for_scene(settings, prm, drv, y)
+
+
+def point_to_frame(variant, prm, x, z, vx, vz):
+    """The tangent frame's (zeta, u, w) of the point (x, z) moving at (vx, vz)
+    (docs/physics.md, Sec. 4): zeta = (z - h) cos a, u = vx / cos a,
+    w = cos a (vz - u sin a - zeta h'' u sin a cos a)."""
+    height, slope = variant.profile(x, prm)
+    cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
+    sin_a = slope * cos_a
+    zeta, u = (z - height) * cos_a, vx / cos_a
+    return zeta, u, cos_a * (vz - u * sin_a - zeta * variant.curvature(x, prm) * u * sin_a * cos_a)
+
+
+def frame_to_point(variant, prm, x, zeta, u, w):
+    """The point (z, vx, vz) of a tangent-frame state (x, zeta, u, w): z = h + zeta / cos a,
+    vx = u cos a, vz = u sin a + w / cos a + zeta h'' u sin a cos a."""
+    height, slope = variant.profile(x, prm)
+    cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
+    sin_a = slope * cos_a
+    return (height + zeta / cos_a, u * cos_a,
+            u * sin_a + w / cos_a + zeta * variant.curvature(x, prm) * u * sin_a * cos_a)
+
+
+def _place_in_tangent_frame(settings: Settings, prm, y, weight, phase) -> None:
+    """The starts of Sec. 10 in the tangent frame's slots (x, zeta, u, w): the plate's
+    position P along the normal, the start parameters read through the inverse map."""
+    p, variant = settings.parameters, settings.variant
+    x = p["x_start"]
+    plate_p, plate_v = p["A"] * math.sin(phase), p["A"] * p["omega"] * math.cos(phase)
+    zeta, u, w = point_to_frame(variant, prm, x, p["z_start"], p["vx_start"], p["vz_start"])
+    if settings.initial_state == 0:
+        zeta = plate_p - weight / p["k_n"]
+        height, slope = variant.profile(x, prm)
+        z = height + zeta * math.sqrt(1.0 + slope * slope)  # h + zeta / cos a
+        _, u, w = point_to_frame(variant, prm, x, z, p["vx_start"], p["vz_start"])
+    elif settings.initial_state == 2:
+        offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+        zeta, w = plate_p + offset, plate_v + rate
+    y[L.Y_Z], y[L.Y_VX], y[L.Y_VZ] = zeta, u, w
 
 
 def _place_for_scene(settings: Settings, prm, drv, y) -> bool:

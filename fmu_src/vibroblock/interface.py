@@ -4,7 +4,7 @@ The README's interface table is this module's output; a test keeps the two equal
 """
 from .integrators import INTEGRATOR_RECORDS, INTEGRATORS
 from .models import VARIANTS, offered_by
-from .parameters import INITIAL_STATES, SCENE_OPTIONS
+from .parameters import INITIAL_STATES, READINGS, SCENE_OPTIONS
 
 INPUTS = {
     "plate_z": ("delta_0", "external plate height, added to the internal drive"),
@@ -23,7 +23,8 @@ OUTPUTS = {
     "contact": ("Boolean", "", "block penetrates the plate (delta > 0)"),
     "slip_count": ("Integer", "", "Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since the start"),
     "phi_integral": ("Real", "delta_0^2/tau_0", "integral of (vx - V_d)^2 dt since the start"),
-    "penetration": ("Real", "delta_0", "penetration delta = (Z_p - z) cos(alpha) along the surface normal; > 0 in contact"),
+    "penetration": ("Real", "delta_0", "penetration delta along the surface normal, > 0 in contact: (Z_p - z) cos(alpha) "
+                    "(formulation 0), P(t) - zeta (formulation 1, zeta the block's normal coordinate)"),
     "surface_z": ("Real", "delta_0", "height of the plate surface Z_p(x, t) under the block"),
     "work_input": ("Real", "m_0 delta_0^2/tau_0^2", "work done on the block by the drive, the plate and the load "
                    "since the start (with energy_balance)"),
@@ -36,6 +37,12 @@ INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items(
 ENERGY_BALANCE = "account work, dissipation and stored energy (outputs work_input, energy_dissipated, " \
     "energy_residual; about a third more time per step)"
 INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
+
+
+def reading_choices(name: str) -> str:
+    """The FMU description of a reading: its values and what each means."""
+    return "; ".join(f"{value} = {text}" for value, text in READINGS[name][1].items()) + \
+        " (docs/physics.md; fixed before initialization)"
 
 
 def _models_column(names) -> str:
@@ -70,6 +77,9 @@ def markdown_table() -> str:
                     f"{p.description} |")
     rows.append(f"| `integrator` | parameter (Integer) | {every} | | 0 | {INTEGRATOR_CHOICES} |")
     rows.append(f"| `initial_state` | parameter (Integer) | {every} | | 0 | {INITIAL_CHOICES} |")
+    for name, (models, _) in READINGS.items():
+        rows.append(f"| `{name}` | parameter (Integer) | {_models_column(offered_by(models))} | | 0 | "
+                    f"{reading_choices(name)} |")
     rows.append(f"| `energy_balance` | parameter (Boolean) | {every} | | false | {ENERGY_BALANCE} |")
     for name, (models, text) in SCENE_OPTIONS.items():
         rows.append(f"| `{name}` | parameter (Boolean) | {_models_column(offered_by(models))} | | false | {text} |")

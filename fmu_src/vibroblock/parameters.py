@@ -7,8 +7,8 @@ A variant's own parameters and its defaults are declared in its module (``models
 loads nothing but the standard library.
 
 Units follow the paper (Sec. II C): m = g = k_n = 1, lengths in delta_0 = m g / k_n,
-times in tau_0 = sqrt(m / k_n).  Physical parameters are Real; the switches (integrator, initial state, scene options)
-are Integer or Boolean.
+times in tau_0 = sqrt(m / k_n).  Physical parameters are Real; the switches (integrator, initial state, readings,
+scene options) are Integer or Boolean.
 """
 from __future__ import annotations
 
@@ -93,3 +93,27 @@ INITIAL_STATES = {
     1: "given: x_start, z_start, vx_start, vz_start as set",
     2: "steady_orbit: on the steady in-contact orbit of the harmonic drive (exact for model A)",
 }
+
+# The readings of the paper a run chooses (docs/physics.md): Integer parameters, fixed
+# before initialization; name -> (variants that offer it, {value: "name: meaning"}).
+# 0 is today's reading and the default.  One table for the FMU variables, the core's
+# validation and the README.
+READINGS = {
+    "formulation": ("BC", {
+        0: "fixed_axes: Newton's law for the block as a point in fixed axes, the plate moving vertically",
+        1: "tangent_frame: the paper's Eqs. (3)-(6) as printed, in a frame tangent to the plate at the block",
+    }),
+    "coulomb_normal": (ALL_VARIANTS, {
+        0: "contact_force: Coulomb bound mu_s N with N = k_n delta - gamma_n u_n",
+        1: "applied_load: N = the load's and the drive spring's normal components, -(load + drive) . n",
+    }),
+    "flight": (ALL_VARIANTS, {
+        0: "surface: off contact the load and tangential dashpot act as on the surface under the block",
+        1: "free: off contact a free particle (vertical load, dashpot on dx/dt); fixed_axes only",
+    }),
+}
+
+
+def reading_names(name: str) -> dict[int, str]:
+    """value -> short name of one reading (e.g. 0 -> "fixed_axes")."""
+    return {value: text.split(":", 1)[0] for value, text in READINGS[name][1].items()}

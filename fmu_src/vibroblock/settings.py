@@ -1,5 +1,6 @@
 """Checked settings of one block: model variant, parameters, integrator, initial state,
-energy balance and scene reductions.
+readings of the paper (formulation, Coulomb bound, flight), energy balance and scene
+reductions.
 
 Every value is checked when it is set (``ModelError`` says which value and why), and the
 settings are checked together (``check``) before a run starts; once a run has started
@@ -13,7 +14,8 @@ import numpy as np
 
 from .integrators import INTEGRATORS, REDUCED_SCENE, Integrator, integrator as integrator_record
 from .models import offered_by, variant
-from .parameters import INITIAL_STATES, SCENE_OPTIONS
+from .parameters import INITIAL_STATES, READINGS, SCENE_OPTIONS, reading_names
+from .readings import encode
 from .scenes import COULOMB, FROZEN, RIGID
 
 
@@ -25,6 +27,20 @@ def _unsupported(record: Integrator, model: str) -> str:
     models = offered_by(record.models)
     return (f"the {record.name} integrator is available only for model{'s' if len(models) > 1 else ''} "
             f"{', '.join(models)}, not model {model} ({record.summary}); choose another integrator")
+
+
+# Readings an integrator does not implement: integrator name -> why not (None: fine).
+UNSUPPORTED_READINGS = {
+    "implicit_contact": lambda r: (
+        "integrates the fixed-axes reading only (its closed-form contact flows, the frame's turning terms "
+        "and their energy accounting are written for a point in fixed axes), not formulation = 1 "
+        "(tangent_frame)" if r["formulation"] == 1 else
+        "follows the surface's frame in flight too (its flight segments are exact flows along the frozen "
+        "tangent), not flight = 1 (free)" if r["flight"] == 1 else None),
+    "event_driven": lambda r: (
+        "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 (applied_load)"
+        if r["coulomb_normal"] == 1 else None),
+}
 
 
 class Settings:
@@ -44,12 +60,15 @@ class Settings:
         self.initial_state = 0
         self.energy_balance = False
         self.scene = {name: False for name in SCENE_OPTIONS}
+        self.readings = {name: 0 for name in READINGS}
         self.set_integrator(integrator)
         self.set_initial_state(initial_state)
         self.set_energy_balance(energy_balance)
-        for name, value in parameters.items():  # scene options come as Boolean keywords
+        for name, value in parameters.items():  # scene options and readings come as keywords
             if name in SCENE_OPTIONS:
                 self.set_scene_option(name, value)
+            elif name in READINGS:
+                self.set_reading(name, value)
             else:
                 self.set_parameter(name, value)
 
@@ -98,6 +117,35 @@ class Settings:
         self._require_unlocked(name)
         self.scene[name] = bool(enabled)
 
+    def set_reading(self, name: str, value: int | str) -> None:
+        """Choose a reading of the paper (``parameters.READINGS``: formulation,
+        coulomb_normal, flight), by its Integer value or its name."""
+        if name not in READINGS:
+            raise ModelError(f"unknown reading {name!r}; choose one of {sorted(READINGS)}")
+        models, _ = READINGS[name]
+        names = reading_names(name)
+        if isinstance(value, str) and value in names.values():
+            value = {text: code for code, text in names.items()}[value]
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or int(value) not in names:
+            raise ModelError(f"{name} = {value!r} is not admissible: it must be one of "
+                             f"{', '.join(f'{code} ({text})' for code, text in names.items())}")
+        offered = offered_by(models)
+        if value and self.model not in offered:
+            raise ModelError(f"{name} = {value} ({names[int(value)]}) is available for models {', '.join(offered)}, "
+                             f"not model {self.model}; model {self.model} has {name} = 0 ({names[0]}) only")
+        self._require_unlocked(name)
+        self.readings[name] = int(value)
+
+    @property
+    def kind(self) -> int:
+        """The kernels' compile-time ``kind``: the variant and its readings (``vibroblock.readings``)."""
+        r = self.readings
+        return encode(self.variant.kind, r["formulation"], r["coulomb_normal"], r["flight"])
+
+    @property
+    def tangent_frame(self) -> bool:
+        return self.readings["formulation"] == 1
+
     def set_initial_state(self, mode: int) -> None:
         if mode not in INITIAL_STATES:
             raise ModelError(f"initial_state = {mode!r} is not one of {INITIAL_STATES}")
@@ -123,15 +171,34 @@ class Settings:
 
     def check(self, frozen_released: bool = False) -> None:
         """Refuse settings that cannot run together (e.g. a dt the integrator cannot resolve)."""
+        self._check_readings()
         if self.scene_flags(frozen_released):
             self._check_scene_step()
             return
         record = integrator_record(self.integrator)
         if not record.supports(self.model):
             raise ModelError(_unsupported(record, self.model))
+        problem = UNSUPPORTED_READINGS.get(record.name, lambda r: None)(self.readings)
+        if problem:
+            raise ModelError(f"the {record.name} integrator {problem}; choose symplectic_euler or rk4")
         problem = record.check_step(self.parameters, self.model, record.name)
         if problem:
             raise ModelError(problem)
+
+    def _check_readings(self) -> None:
+        r = self.readings
+        if r["formulation"] == 1 and r["flight"] == 1:
+            raise ModelError(
+                "flight = 1 (free) cannot be combined with formulation = 1 (tangent_frame): the tangent frame has "
+                "no position in the plane, only the foot's abscissa x and the normal coordinate zeta, so a free "
+                "flight and its landing on the vibrating curved plate are not defined in it (docs/physics.md, "
+                "Sec. 6); its flight is the printed equations with Theta = 0 (flight = 0)")
+        if any(r.values()) and any(self.scene.values()):
+            active = [name for name, on in self.scene.items() if on]
+            readings = [f"{name} = {value}" for name, value in r.items() if value]
+            raise ModelError(f"the scene reductions ({', '.join(active)}) run the default reading only "
+                             f"(formulation, coulomb_normal and flight 0), not {', '.join(readings)}; "
+                             "switch the reduction off or the reading back to 0")
 
     def _check_scene_step(self) -> None:
         """Reduced scenes run their own first-order scheme (vibroblock.scenes): it needs
@@ -162,9 +229,9 @@ class Settings:
     def to_dict(self) -> dict:
         return {"model": self.model, "integrator": self.integrator, "initial_state": self.initial_state,
                 "energy_balance": self.energy_balance, "scene": dict(self.scene),
-                "parameters": dict(self.parameters)}
+                "readings": dict(self.readings), "parameters": dict(self.parameters)}
 
     @classmethod
     def from_dict(cls, data: dict) -> "Settings":
         return cls(data["model"], data["integrator"], data["initial_state"], data["energy_balance"],
-                   **data["parameters"], **data.get("scene", {}))
+                   **data["parameters"], **data.get("scene", {}), **data.get("readings", {}))

@@ -17,11 +17,11 @@ from pythonfmu.variables import Boolean, Integer, Real
 
 from .block import Block
 from .fmi import FmuFacade, fmu_class
-from .interface import ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS
+from .interface import ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS, reading_choices
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .integrators import INTEGRATORS
 from .models import offered_by, variant
-from .parameters import SCENE_OPTIONS
+from .parameters import READINGS, SCENE_OPTIONS
 from .settings import ModelError
 
 
@@ -64,6 +64,12 @@ class BlockFacade(FmuFacade):
             "energy_balance", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=ENERGY_BALANCE, getter=lambda: self.block.energy_balance,
             setter=lambda value: self._guard(self.block.set_energy_balance, bool(value))))
+        for name, (models, _) in READINGS.items():  # only the readings this model offers
+            if self.model in offered_by(models):
+                self.register_variable(Integer(
+                    name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+                    description=reading_choices(name), getter=lambda name=name: self.block.readings[name],
+                    setter=lambda value, name=name: self._guard(self.block.set_reading, name, int(value))))
         for name, (models, text) in SCENE_OPTIONS.items():  # only the reductions this model offers
             if self.model in offered_by(models):
                 self.register_variable(Boolean(
@@ -141,7 +147,7 @@ class BlockFacade(FmuFacade):
     def _restore(self, state: dict) -> None:
         try:
             block = Block(self.model, state["integrator"], state["initial_state"], state["energy_balance"],
-                          **state["parameters"], **state.get("scene", {}))
+                          **state["parameters"], **state.get("scene", {}), **state.get("readings", {}))
             if state["block"] is not None:
                 block.set_state(state["block"])
             plate_input = {name: float(state["plate_input"][name]) for name in INPUTS}

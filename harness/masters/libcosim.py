@@ -202,7 +202,9 @@ def _typed(var: _Variable, value: object, role: str) -> Value:
     elif isinstance(value, (bool, np.bool_)):
         pass
     elif var.type == "integer":
-        if isinstance(value, (int, np.integer)) and _INT32[0] <= value <= _INT32[1]:
+        # a whole float is that int (``RunSettings.parameters`` holds numbers as floats)
+        whole = isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer()
+        if (isinstance(value, (int, np.integer)) or whole) and _INT32[0] <= value <= _INT32[1]:
             return int(value)
     elif isinstance(value, (int, float, np.integer, np.floating)):
         return float(value)
@@ -228,7 +230,7 @@ def run_libcosim(
     fmu_path: the ``.fmu`` file.
     start_values: variable name -> value for parameters and inputs, set before
         initialisation; the Python type must suit the variable (bool for Boolean,
-        int for Integer, int or float for Real).
+        int or a whole float for Integer, int or float for Real).
     stop_time, step_size, start_time: the communication grid, in seconds; see the
         module docstring for libcosim's nanosecond clock.
     outputs: names of the Real, Integer and Boolean variables to record.

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
-from fmpy.fmi2 import FMU2Slave, fmi2Error, fmi2OK
+from fmpy.fmi2 import FMU2Slave, fmi2Error, fmi2Integer, fmi2OK, fmi2ValueReference
 from fmpy.validation import validate_fmu
 
 from fmu_testing import do_step, fmu_log, set_real, status_of  # noqa: F401 (fixture)
@@ -274,3 +274,57 @@ def test_an_instance_freed_right_after_instantiation_does_not_crash_the_host(fmu
     """)
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert done.returncode == 0 and "freed" in done.stdout, done.stderr[-2000:]
+
+
+def set_integer(slave, vr, value) -> int:
+    return status_of(lambda: slave.fmi2SetInteger(slave.component, (fmi2ValueReference * 1)(vr), 1,
+                                                  (fmi2Integer * 1)(value)))
+
+
+@pytest.mark.parametrize("name, value", [("formulation", 2), ("formulation", -1), ("coulomb_normal", 7),
+                                         ("flight", 2)])
+def test_bad_readings_give_fmi2error_with_a_message_and_the_host_goes_on(extracted, fmu_log, name, value):
+    md, unzipdir = extracted["C"]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="BlockC", instanceName="readings")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        assert set_integer(slave, vr[name], value) == fmi2Error
+        assert any(status == fmi2Error and name in message and "0 (" in message
+                   for _, status, _, message in fmu_log.records)
+        assert slave.getInteger([vr[name]]) == [0]
+        slave.exitInitializationMode()
+        assert do_step(slave, 0.0, 1.0) == fmi2OK
+    finally:
+        slave.freeInstance()
+
+
+def test_tangent_frame_with_free_flight_is_refused_at_initialization(extracted, fmu_log):
+    md, unzipdir = extracted["B"]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="BlockB", instanceName="combination")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setInteger([vr["formulation"], vr["flight"]], [1, 1])
+        assert status_of(lambda: slave.fmi2ExitInitializationMode(slave.component)) == fmi2Error
+        assert any("no position in the plane" in message for *_, message in fmu_log.records)
+        assert do_step(slave, 0.0, 1.0) == fmi2Error  # not initialized: refused, no crash
+    finally:
+        slave.freeInstance()
+    assert "formulation" not in {v.name for v in extracted["A"][0].modelVariables}
+
+
+def test_the_tangent_frame_fmu_equals_the_core(extracted, fmu_log):
+    settings = dict(SCALED, A_x=1.0, omega_x=0.5, A=1.5, omega=0.8, x_start=1.0)
+    with instance(extracted, "C", fmu_log, dict(settings, formulation=1, coulomb_normal=1, initial_state=2)) \
+            as (slave, vr):
+        slave.doStep(0.0, 5.0)
+        got = reals(slave, vr)
+    block = Block("C", initial_state=2, formulation=1, coulomb_normal=1, **settings)
+    block.start()
+    block.advance_to(5.0)
+    assert got == [block.outputs()[n] for n in OUTPUTS]

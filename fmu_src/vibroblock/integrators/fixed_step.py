@@ -9,14 +9,15 @@ smallest example):
 ``step(kind, flags, ctx, prm, drv, x, z, vx, vz, F, contact0, t, h, span, plate, track_energy)``
     one step of length h from the state at time t, whose contact quantities
     ``contact0`` (``dynamics.contact``: penetration, u_n, u_t, cos a, sin a, N) are
-    known.  ``span`` is the step as the difference of the grid times it joins (differs
+    known (in the tangent frame the slots hold (x, zeta, u, w), ``dynamics``).  ``span`` is the step as the difference of the grid times it joins (differs
     from h by rounding; a scheme uses one or the other, always the same).  ``plate`` is
     (height, velocity) at t, at t + span/2 and at t + h, and the drive's (sin, cos) at
     t + h.  Returns (status, x, z, vx, vz, F, contact1, rule_penetration, rule_normal,
     d_phi, d_work, d_dissipated, d_normal): status 0, STOP (the step is not taken: a
     scene's guard hands over) or a negative failure code; the contact quantities at
-    the new state; what the friction rule is to see there; and the step's increments of
-    the quadratures.
+    the new state; what the friction rule is to see there (the penetration and the
+    contact force; the driver swaps in the applied load when the run's Coulomb bound is
+    that, ``dynamics.coulomb_bound``); and the step's increments of the quadratures.
 
 The driver owns everything else: the grid and the plate drive, the friction rule and
 the quadratures at the end of every step (``settle``), the counters, the finite-state
@@ -30,7 +31,7 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import literally, njit, types
 from numba.extending import overload
 
-from ..dynamics import contact, friction_rule
+from ..dynamics import contact, coulomb_bound, friction_rule
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
                       P_KT, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
@@ -136,6 +137,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
                 return status
             break
         x, z, vx, vz, contact0 = x1, z1, vx1, vz1, contact1
+        rule_normal = coulomb_bound(kind, rule_normal, x, t1, prm)  # the contact force, or the applied load
         shear, slips, phi, phi_c, work, dissipated, e_normal = settle(
             prm, shear1, rule_pen, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
             d_phi, d_work, d_dissipated, d_normal, track_energy)
@@ -186,6 +188,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         state_contact = contact(kind, x, z, vx, vz, pz1, pv1, prm)
         if status != OK:
             rule_pen, rule_normal = state_contact[0], state_contact[5]
+        rule_normal = coulomb_bound(kind, rule_normal, x, t + h, prm)
         loaded = shear
         shear, reset = friction_rule(shear, rule_pen, rule_normal, prm)
         slips += reset

@@ -1,4 +1,5 @@
-"""``rk4`` (id 1): classical fourth-order Runge-Kutta on (x, z, vx, vz, F, phi).
+"""``rk4`` (id 1): classical fourth-order Runge-Kutta on (x, z, vx, vz, F, phi) (in the
+tangent frame on (x, zeta, u, w, F, phi), the position moving at ``position_rates``).
 
 The contact gate Theta(delta) is evaluated inside each stage; the friction rule is the
 driver's, after the step.  Fourth order between events, first order across a contact
@@ -8,7 +9,7 @@ dt^2 k/m + 2 dt gamma/m <= 8 (imaginary axis) or ~5.6 (real axis): we ask <= 4.
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from ..dynamics import contact, energy_rates, force
+from ..dynamics import contact, energy_rates, force, position_rates
 from ..layout import P_M, P_VD
 
 
@@ -24,12 +25,13 @@ def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_shear = u_t if pen > 0.0 else 0.0
-    dv = vx - prm[P_VD]
+    rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz) for a point
+    dv = rate_x - prm[P_VD]
     work = dissipation = storage = 0.0
     if track_energy:
         work, dissipation, storage = energy_rates(kind, x, vx, vz, t, pen, u_n, u_t, cos_a, sin_a, normal,
                                                   shear, plate_v, prm)
-    return fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv, work, dissipation, storage
+    return rate_x, rate_z, fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv, work, dissipation, storage
 
 
 @njit(inline="always")
@@ -37,19 +39,19 @@ def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, p
     """One classical RK4 step of length h; returns the new state and the increments of
     phi, work, dissipation and normal-spring energy."""
     half = 0.5 * h
-    ax1, az1, df1, p1, w1, d1, e1 = _rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0, track_energy)
+    rx1, rz1, ax1, az1, df1, p1, w1, d1, e1 = _rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0, track_energy)
     vx2, vz2 = vx + half * ax1, vz + half * az1
-    ax2, az2, df2, p2, w2, d2, e2 = _rhs(kind, prm, x + half * vx, z + half * vz, vx2, vz2,
-                                         shear + half * df1, t + half, pz_half, pv_half, track_energy)
+    rx2, rz2, ax2, az2, df2, p2, w2, d2, e2 = _rhs(kind, prm, x + half * rx1, z + half * rz1, vx2, vz2,
+                                                   shear + half * df1, t + half, pz_half, pv_half, track_energy)
     vx3, vz3 = vx + half * ax2, vz + half * az2
-    ax3, az3, df3, p3, w3, d3, e3 = _rhs(kind, prm, x + half * vx2, z + half * vz2, vx3, vz3,
-                                         shear + half * df2, t + half, pz_half, pv_half, track_energy)
+    rx3, rz3, ax3, az3, df3, p3, w3, d3, e3 = _rhs(kind, prm, x + half * rx2, z + half * rz2, vx3, vz3,
+                                                   shear + half * df2, t + half, pz_half, pv_half, track_energy)
     vx4, vz4 = vx + h * ax3, vz + h * az3
-    ax4, az4, df4, p4, w4, d4, e4 = _rhs(kind, prm, x + h * vx3, z + h * vz3, vx4, vz4,
-                                         shear + h * df3, t + h, pz1, pv1, track_energy)
+    rx4, rz4, ax4, az4, df4, p4, w4, d4, e4 = _rhs(kind, prm, x + h * rx3, z + h * rz3, vx4, vz4,
+                                                   shear + h * df3, t + h, pz1, pv1, track_energy)
     sixth = h / 6.0
-    return (x + sixth * (vx + 2.0 * vx2 + 2.0 * vx3 + vx4),
-            z + sixth * (vz + 2.0 * vz2 + 2.0 * vz3 + vz4),
+    return (x + sixth * (rx1 + 2.0 * rx2 + 2.0 * rx3 + rx4),
+            z + sixth * (rz1 + 2.0 * rz2 + 2.0 * rz3 + rz4),
             vx + sixth * (ax1 + 2.0 * ax2 + 2.0 * ax3 + ax4),
             vz + sixth * (az1 + 2.0 * az2 + 2.0 * az3 + az4),
             shear + sixth * (df1 + 2.0 * df2 + 2.0 * df3 + df4),

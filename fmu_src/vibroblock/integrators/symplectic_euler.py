@@ -2,14 +2,15 @@
 
 Velocity first, then position with the new velocity (semi-implicit Euler); the shear
 displacement grows by h times the new tangential velocity while the step started in
-contact, so on a flat plate F is exactly the horizontal travel since contact began.
+contact, so on a flat plate F is exactly the horizontal travel since contact began.  In the tangent frame the same step on (x, zeta, u, w): the foot moves
+by h u cos a at the step's starting slope.
 First order, one force evaluation per step; stable while dt^2 k/m + 2 dt gamma/m <= 4
 for each spring-dashpot (we ask <= 1, which keeps the contact's ringing resolved).
 """
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from ..dynamics import contact, energy_rates, force
+from ..dynamics import contact, energy_rates, force, position_rates
 from ..layout import P_M, P_VD
 
 
@@ -33,12 +34,13 @@ def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plat
     engaged = pen > 0.0
     vx += h_over_m * fx
     vz += h_over_m * fz
-    x += h * vx
-    z += h * vz
+    rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz) for a point
+    x += h * rate_x
+    z += h * rate_z
     contact_new = contact(kind, x, z, vx, vz, pz1, pv1, prm)
     if engaged:
         shear += h * contact_new[2]
-    dv = vx - prm[P_VD]
+    dv = rate_x - prm[P_VD]
     return x, z, vx, vz, shear, contact_new, h * dv * dv, d_work, d_dissipated, d_normal
 
 

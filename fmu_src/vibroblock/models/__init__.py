@@ -9,14 +9,17 @@ A variant is one module ``model_<name>.py`` stating:
 * ``profile(x, prm) -> (height, slope)``: the plate surface's static shape, added to
   the plate's vertical motion (Z_p(x, t) = plate(t) + height(x));
 * ``load(cos_a, sin_a, prm) -> (fx, fz)``: the confining force on the block, given the
-  unit tangent (cos a, sin a) of the surface under it.
+  unit tangent (cos a, sin a) of the surface under it;
+* ``curvature(x, prm)``: the profile's second derivative h''(x) (the tangent frame's
+  map to a point, ``vibroblock.readings``; not on any kernel's hot path).
 
 Everything else (contact, friction, integrators, the FMU, the docs) is shared and
 reads this registry: adding a variant is adding a module.  The compiled kernels reach a
 variant's ``profile`` and ``load`` through ``profile(kind, ...)`` and
 ``load(kind, ...)`` below, resolved at compile time from the kernel's constant ``kind``
-(the kernels take ``kind`` as a literal), so each kernel is compiled for the variants
-it is used with only.
+(the kernels take ``kind`` as a literal; its low bits are the variant's index, the
+others the run's readings, ``vibroblock.readings``), so each kernel is compiled for the
+variants it is used with only.
 """
 from __future__ import annotations
 
@@ -31,6 +34,7 @@ from numba import types  # noqa: E402
 from numba.extending import overload  # noqa: E402
 
 from ..parameters import COMMON_PARAMETERS, OPTIONAL_COMMON, VARIANT_AFTER, Parameter  # noqa: E402
+from ..readings import VARIANT_MASK  # noqa: E402
 
 MODULE_PREFIX = "model_"
 
@@ -43,6 +47,7 @@ class Variant:
     parameters: tuple[Parameter, ...]  # the FMU's parameters of this variant, in order
     profile: Callable
     load: Callable
+    curvature: Callable
     module: ModuleType
 
     @property
@@ -76,12 +81,14 @@ def _assemble_parameters(module: ModuleType) -> tuple[Parameter, ...]:
 def _discover() -> dict[str, Variant]:
     names = sorted(info.name for info in pkgutil.iter_modules(__path__) if info.name.startswith(MODULE_PREFIX))
     found = {}
+    if len(names) > VARIANT_MASK + 1:
+        raise RuntimeError(f"more variants than the kernels' kind can hold ({VARIANT_MASK + 1}): widen readings.VARIANT_MASK")
     for kind, module_name in enumerate(names):
         module = importlib.import_module(f"{__name__}.{module_name}")
         name = module_name[len(MODULE_PREFIX):].upper()
         description = module.__doc__.strip().splitlines()[0].rstrip(".")
         found[name] = Variant(name, kind, description, _assemble_parameters(module), module.profile,
-                              module.load, module)
+                              module.load, module.curvature, module)
     return found
 
 
@@ -124,7 +131,7 @@ def load(kind, cos_a, sin_a, prm):
 @overload(profile, inline="always")
 def _profile(kind, x, prm):
     if isinstance(kind, types.IntegerLiteral):
-        geometry = _BY_KIND[kind.literal_value].profile
+        geometry = _BY_KIND[kind.literal_value & VARIANT_MASK].profile
         return lambda kind, x, prm: geometry(x, prm)
     return None  # the kernel must pass kind as a literal (numba.literally)
 
@@ -132,6 +139,6 @@ def _profile(kind, x, prm):
 @overload(load, inline="always")
 def _load(kind, cos_a, sin_a, prm):
     if isinstance(kind, types.IntegerLiteral):
-        force = _BY_KIND[kind.literal_value].load
+        force = _BY_KIND[kind.literal_value & VARIANT_MASK].load
         return lambda kind, cos_a, sin_a, prm: force(cos_a, sin_a, prm)
     return None

@@ -14,3 +14,8 @@ def profile(x, prm):
 @njit(inline="always")
 def load(cos_a, sin_a, prm):
     return 0.0, -prm[P_M] * prm[P_G]
+
+
+@njit(inline="always")
+def curvature(x, prm):
+    return 0.0

@@ -25,3 +25,8 @@ def profile(x, prm):
 @njit(inline="always")
 def load(cos_a, sin_a, prm):
     return 0.0, -prm[P_M] * prm[P_G]
+
+
+@njit(inline="always")
+def curvature(x, prm):
+    return -prm[P_AX] * prm[P_WX] * prm[P_WX] * math.sin(prm[P_WX] * x)

@@ -4,7 +4,7 @@ from numba import njit
 from ..layout import slot
 from ..parameters import NON_NEGATIVE, Parameter
 from .model_b import CORRUGATION, DEFAULTS as MODEL_B_DEFAULTS
-from .model_b import profile as corrugated_profile
+from .model_b import curvature, profile as corrugated_profile  # noqa: F401  (curvature: model B's)
 
 PARAMETERS = (*CORRUGATION,
               Parameter("P_l", 1.0, "m_0 delta_0/tau_0^2", "confining force, normal to the plate surface", NON_NEGATIVE))
