@@ -10,8 +10,8 @@ A variant is one module ``model_<name>.py`` stating:
   the plate's vertical motion (Z_p(x, t) = plate(t) + height(x));
 * ``load(cos_a, sin_a, prm) -> (fx, fz)``: the confining force on the block, given the
   unit tangent (cos a, sin a) of the surface under it;
-* ``curvature(x, prm)``: the profile's second derivative h''(x) (the tangent frame's
-  map to a point, ``vibroblock.readings``; not on any kernel's hot path).
+* ``curvature(x, prm)`` (optional; zero, a plane, if absent): the profile's second
+  derivative h''(x) (the tangent frame's map to a point, ``vibroblock.readings``; not on any kernel's hot path).
 
 Everything else (contact, friction, integrators, the FMU, the docs) is shared and
 reads this registry: adding a variant is adding a module.  The compiled kernels reach a
@@ -30,7 +30,7 @@ from types import ModuleType
 from typing import Callable
 
 from .. import jitcache  # noqa: F401  (before numba: the kernel cache's folder and locator)
-from numba import types  # noqa: E402
+from numba import njit, types  # noqa: E402
 from numba.extending import overload  # noqa: E402
 
 from ..parameters import COMMON_PARAMETERS, OPTIONAL_COMMON, VARIANT_AFTER, Parameter  # noqa: E402
@@ -78,6 +78,12 @@ def _assemble_parameters(module: ModuleType) -> tuple[Parameter, ...]:
     return tuple(out)
 
 
+@njit(inline="always")
+def _flat(x, prm):
+    """Curvature of a variant that states none: a plane surface (flat or tilted)."""
+    return 0.0
+
+
 def _discover() -> dict[str, Variant]:
     names = sorted(info.name for info in pkgutil.iter_modules(__path__) if info.name.startswith(MODULE_PREFIX))
     found = {}
@@ -88,7 +94,7 @@ def _discover() -> dict[str, Variant]:
         name = module_name[len(MODULE_PREFIX):].upper()
         description = module.__doc__.strip().splitlines()[0].rstrip(".")
         found[name] = Variant(name, kind, description, _assemble_parameters(module), module.profile,
-                              module.load, module.curvature, module)
+                              module.load, getattr(module, "curvature", _flat), module)
     return found
 
 
