@@ -78,6 +78,12 @@ def _key(core: Path) -> str:
     return digest.hexdigest()[:16]
 
 
+def kept_kernels(core: Path) -> Path | None:
+    """The folder of kernels compiled for the core at ``core`` by an earlier build, if any."""
+    folder = WORK_DIR / f"kernels-{_key(core)}"
+    return folder if folder.is_dir() else None
+
+
 def compile_kernels(core: Path) -> Path:
     """The folder of compiled kernels for the core at ``core`` (compiled if not kept yet)."""
     target = WORK_DIR / f"kernels-{_key(core)}"

@@ -14,6 +14,18 @@ sys.path.insert(0, str(ROOT / "build"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
+@pytest.fixture(scope="session", autouse=True)
+def kernels_compiled_by_the_build():
+    """The build compiles every kernel of the core once (build/kernels.py) to ship it in
+    the FMUs; the tests' own cache starts from those instead of compiling them again."""
+    import kernels
+    from vibroblock import jitcache
+
+    folder = kernels.kept_kernels(ROOT / "fmu_src" / "vibroblock")
+    if folder is not None:
+        jitcache.seed_cache(folder)
+
+
 @pytest.fixture(scope="session")
 def fmu_dir(tmp_path_factory):
     """BlockA/B/C.fmu built from the working tree into a fresh folder."""
