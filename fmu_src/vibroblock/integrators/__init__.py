@@ -186,7 +186,7 @@ _ADAPTIVE_STATUSES = {
         "parameters for extreme values."),
     adaptive.TOO_MANY_STEPS: (
         f"more than {adaptive.MAX_STEPS} internal steps between t = {{t:g}} and t = {{t_end:g}} ({{integrator}}; "
-        "about a minute of work): a master must not be held that long; the state at t = {t:g} is kept. Use "
+        "some 20 s of work): a master must not be held that long; the state at t = {t:g} is kept. Use "
         "shorter communication steps or looser rtol/atol (resolving each plate period over a long stick is "
         "what costs)."),
     adaptive.TOO_MANY_EVENTS: (

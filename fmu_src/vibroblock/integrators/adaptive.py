@@ -78,8 +78,8 @@ EVENT_SAMPLES = 4
 EVENT_TOL = 1e-12
 # Resets closer together than this (tau_0) are the accumulation before a zero of N.
 CASCADE_GAP = 1e-9
-# Internal steps (accepted + rejected) one call may take: about a minute on one core.
-MAX_STEPS = 1 << 26
+# Internal steps (accepted + rejected) one call may take: ~20-30 s on one core.
+MAX_STEPS = 1 << 24
 # Events in a row without the time moving by more than EVENT_TOL before the run stops.
 MAX_IMMEDIATE = 64
 # Step-size control.
