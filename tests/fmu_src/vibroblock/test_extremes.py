@@ -31,7 +31,7 @@ BOUND = {"symplectic_euler": 2e-2, "rk4": 1e-6, "implicit_contact": 1e-4, "adapt
 HORIZON = 100.0
 
 REFUSED_STEP = r"too large for the .* use dt <="  # an explicit scheme's stability limit, with the admissible dt
-BUDGET = r"more than \d+ internal steps between"  # adaptive's per-call step budget  # an explicit scheme's stability limit, with the admissible dt
+BUDGET = r"more than \d+ internal steps between"  # adaptive's per-call step budget
 TOO_FAST = r"crosses the corrugation too fast for dt"
 
 # case -> (models, parameters, {integrator: expected error or None})
