@@ -64,7 +64,11 @@ COMMON_PARAMETERS: tuple[Parameter, ...] = (
     Parameter("V_d", 2e-5, f"{L}/{T}", "drive velocity of the spring's far end", FINITE),
     Parameter("A", 0.0, L, "amplitude of the internal plate drive A sin(omega t)", FINITE, tunable=True),
     Parameter("omega", 0.0, f"1/{T}", "angular frequency of the internal plate drive", NON_NEGATIVE, tunable=True),
-    Parameter("dt", 4e-4, T, "internal integration step", POSITIVE),
+    Parameter("dt", 4e-4, T, "internal integration step (adaptive, event_driven: the grid the state is stored on)",
+              POSITIVE),
+    Parameter("rtol", 1e-8, "1", "relative tolerance of the adaptive integrator's local error", POSITIVE),
+    Parameter("atol", 1e-10, "delta_0, delta_0/tau_0", "absolute tolerance of the adaptive integrator's local error "
+              "(lengths and velocities)", POSITIVE),
     Parameter("x_start", 0.0, L, "initial horizontal position", FINITE),
     Parameter("z_start", 0.0, L, "initial height (used when initial_state = 1)", FINITE),
     Parameter("vx_start", 0.0, f"{L}/{T}", "initial horizontal velocity", FINITE),

@@ -18,7 +18,16 @@ near a valley of their corrugation):
   velocity, phi, contact fraction (sampled every 0.5) and the energy residual (relative
   to the energy dissipated; exactly 0);
 * ``B`` and ``C``: the paper's corrugation (A_x = 1e3, omega_x = 0.02), sub-threshold
-  vibration A = 0.2, omega = 0.8, from a slope of 0.1 near a valley (t = 600).
+  vibration A = 0.2, omega = 0.8, from a slope of 0.1 near a valley (t = 600);
+* ``B ...`` and ``C ...`` with the scaled drive (k_d = V_d = 1e-2, gamma_t = 5e-3) on the
+  paper's corrugation from that slope: ``stick`` (no vibration, drive spring relaxed: no
+  reset within t = 300), ``stick-slip`` (no vibration, drive spring stretched by 40:
+  Coulomb resets from the start, t = 300), ``sub-threshold`` (A = 0.2, omega = 0.8, t = 200,
+  resets) and ``bouncing`` (A = 1, omega = 0.8, above the onset, t = 30, short enough to
+  stay non-chaotic).
+
+Integrators: the fixed-step ones over dt, ``event_driven`` (model A), ``adaptive`` over
+rtol (atol = rtol / 100).
 
 Non-chaotic scenarios are compared pointwise at the end: x and phi (errors relative to
 their reference values) and z (in delta_0, the rest penetration), the error being the
@@ -29,8 +38,10 @@ estimated by running it again at 1e-11 and reported as the floor.  Peers: scipy'
 LSODA and Radau over a range of tolerances, with the same restarts and solve_ivp's own
 event detection (sign at the step ends), i.e. what a user of solve_ivp gets.
 
-The targets (model A, printed and written in the table): the best scheme against
-symplectic_euler and against the best solve_ivp run, at equal accuracy.
+The targets (printed and written in the table), at equal accuracy: on model A event_driven
+against symplectic_euler and solve_ivp, and adaptive against event_driven (within 10x,
+agreeing to 1e-8); on B and C adaptive against symplectic_euler (>= 100x) and against the
+fastest solve_ivp run reaching the accuracy (>= 30x).
 """
 from __future__ import annotations
 
@@ -47,7 +58,10 @@ ROOT = Path(__file__).resolve().parents[2]
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 VALLEY_X = (-0.5 * math.pi + 0.005) / 0.02  # slope 0.1 of A_x sin(omega_x x) with the paper's A_x, omega_x
 STEPS = (4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4)
-PEERS = {"RK45": (1e-4, 1e-6, 1e-8, 1e-10), "LSODA": (1e-4, 1e-6, 1e-8, 1e-10), "Radau": (1e-4, 1e-6, 1e-8)}
+PEERS = {"RK45": (1e-4, 1e-6, 1e-8, 1e-10), "DOP853": (1e-4, 1e-6, 1e-8, 1e-10),
+         "LSODA": (1e-4, 1e-6, 1e-8, 1e-10), "Radau": (1e-4, 1e-6, 1e-8)}
+RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)  # adaptive's settings
+ADAPTIVE_DT = 1e-2  # its storage grid (no effect on accuracy)
 ACCURACY = 1e-6  # the equal-accuracy level of the targets
 
 
@@ -69,17 +83,24 @@ SCENARIOS = (
     Scenario("A bouncing (chaotic)", "A", dict(SCALED, A=2.8463, omega=0.8), 4000.0, window=(200.0, 4000.0)),
     Scenario("B", "B", dict(A=0.2, omega=0.8), 600.0, x_start=VALLEY_X),
     Scenario("C", "C", dict(A=0.2, omega=0.8), 600.0, x_start=VALLEY_X),
+    *(Scenario(f"{model} {name}", model, dict(SCALED, **extra), horizon, initial, VALLEY_X + offset)
+      for model in "BC"
+      for name, extra, horizon, initial, offset in (
+          ("stick", {}, 300.0, 0, 0.0),
+          ("stick-slip", {}, 300.0, 0, -40.0),
+          ("sub-threshold", dict(A=0.2, omega=0.8), 200.0, 2, 0.0),
+          ("bouncing", dict(A=1.0, omega=0.8), 30.0, 2, 0.0))),
 )
 
 
 # ----------------------------------------------------------------------------- observables
-def core_run(scenario: Scenario, integrator: str, dt: float):
+def core_run(scenario: Scenario, integrator: str, dt: float, **tolerances):
     """Timed run of the physics core; returns (seconds, observables)."""
     from vibroblock import Block
 
     def make():
         block = Block(scenario.model, integrator, dt=dt, initial_state=scenario.initial, x_start=scenario.x_start,
-                      energy_balance=True, **scenario.parameters)
+                      energy_balance=True, **scenario.parameters, **tolerances)
         block.start()
         return block
 
@@ -165,12 +186,16 @@ def measure(scenario: Scenario, quick: bool, log):
     for integrator in INTEGRATORS:
         if integrator == "event_driven" and scenario.model != "A":
             continue
-        settings = (STEPS[2],) if integrator == "event_driven" else steps
-        for dt in settings:
-            seconds, obs = core_run(scenario, integrator, dt)
+        if integrator == "adaptive":
+            runs = [(f"rtol {rtol:g}", ADAPTIVE_DT, {"rtol": rtol, "atol": rtol * 1e-2})
+                    for rtol in (RTOLS[1:3] if quick else RTOLS)]
+        else:
+            runs = [(f"dt {dt:g}", dt, {}) for dt in ((STEPS[2],) if integrator == "event_driven" else steps)]
+        for setting, dt, tolerances in runs:
+            seconds, obs = core_run(scenario, integrator, dt, **tolerances)
             err = errors(scenario, obs, ref)
-            rows.append((integrator, f"dt {dt:g}", seconds, accuracy(scenario, err), err))
-            log(f"  {integrator:17s} dt {dt:<8g} {seconds:9.4f} s  error {accuracy(scenario, err):.2e}")
+            rows.append((integrator, setting, seconds, accuracy(scenario, err), err))
+            log(f"  {integrator:17s} {setting:13s} {seconds:9.4f} s  error {accuracy(scenario, err):.2e}")
     for method, tolerances in PEERS.items():
         for rtol in (tolerances[:2] if quick else tolerances):
             seconds, obs = scipy_run(scenario, Solver(method, rtol, rtol * 1e-2))
@@ -194,6 +219,45 @@ def time_at_accuracy(rows, method, level):
     if slope >= 0.0:
         return math.inf, True
     return float(np.exp(intercept + slope * math.log(level))), True
+
+
+def ratio(numerator: float, denominator: float) -> str:
+    return "n/a" if math.isinf(numerator) or denominator <= 0.0 else f"{numerator / denominator:,.0f}x"
+
+
+def adaptive_targets(results):
+    """adaptive against event_driven on A; against symplectic_euler and solve_ivp on B, C."""
+    lines = []
+    for name, (rows, floor) in results.items():
+        if "chaotic" in name:
+            continue
+        level = max(ACCURACY, floor)
+        t_adaptive, ext_a = time_at_accuracy(rows, "adaptive", level)
+        tight = sorted([r for r in rows if r[0] == "adaptive"], key=lambda r: r[3])[0]
+        if name.startswith("A"):
+            ed = [r for r in rows if r[0] == "event_driven"][0]
+            lines.append(f"- **{name}**: adaptive at {level:.0e}: {t_adaptive * 1e3:.3g} ms"
+                         f"{' (extrapolated)' if ext_a else ''} vs event_driven {ed[2] * 1e3:.3g} ms (error "
+                         f"{ed[3]:.1e}): {ratio(t_adaptive, ed[2])} slower (target <= 10x); adaptive's tightest "
+                         f"run ({tight[1]}) error {tight[3]:.1e}, {tight[2] * 1e3:.3g} ms "
+                         f"({ratio(tight[2], ed[2])} event_driven's time).")
+            continue
+        parts = [f"- **{name}** at {level:.0e}: adaptive {t_adaptive * 1e3:.3g} ms"
+                 f"{' (extrapolated)' if ext_a else ''}"]
+        for label, methods, target in (("symplectic_euler", ["symplectic_euler"], 100),
+                                       ("solve_ivp", [f"solve_ivp {m}" for m in PEERS], 30)):
+            reached = [(sec, method) for method in methods for m, _, sec, err, _ in rows
+                       if m == method and err <= level]
+            if reached:
+                sec, method = min(reached)
+                parts.append(f"{method} measured {sec:.3g} s: {ratio(sec, t_adaptive)} (target >= {target}x)")
+            else:
+                best = sorted([r for r in rows if r[0] in methods], key=lambda r: r[3])[0]
+                parts.append(f"{label} never reached it; its most accurate run ({best[0]}, {best[1]}, error "
+                             f"{best[3]:.1e}, {best[2]:.3g} s) already takes {ratio(best[2], t_adaptive)} "
+                             f"adaptive's time (a lower bound; target >= {target}x)")
+        lines.append("; ".join(parts) + ".")
+    return lines
 
 
 def targets(results):
@@ -235,9 +299,11 @@ def write_outputs(results, out: Path, total: float):
     import matplotlib.pyplot as plt
 
     names = list(results)
-    fig, axes = plt.subplots(2, 4, figsize=(18, 8.5))
+    n_rows = (len(names) + 1 + 3) // 4
+    fig, axes = plt.subplots(n_rows, 4, figsize=(18, 4.25 * n_rows))
     styles = {"symplectic_euler": ("o-", "tab:blue"), "rk4": ("s-", "tab:orange"), "event_driven": ("*", "tab:red"),
-              "implicit_contact": ("d-", "tab:purple"), "solve_ivp RK45": ("^--", "tab:green"),
+              "implicit_contact": ("d-", "tab:purple"), "adaptive": ("h-", "tab:cyan"),
+              "solve_ivp RK45": ("^--", "tab:green"), "solve_ivp DOP853": ("<--", "tab:pink"),
               "solve_ivp LSODA": ("v--", "tab:olive"), "solve_ivp Radau": ("x--", "tab:brown"),
               "reference DOP853": ("P", "black")}
     for ax, name in zip(axes.flat, names):
@@ -288,6 +354,7 @@ def write_outputs(results, out: Path, total: float):
             lines.append(f"| {method} | {setting} | {seconds:.4g} | {err:.2e} | {detail} |")
         lines.append("")
     lines += ["## Targets (model A, equal accuracy)", ""] + targets(results) + [""]
+    lines += ["## Targets of adaptive (equal accuracy)", ""] + adaptive_targets(results) + [""]
     (out / "work_precision.md").write_text("\n".join(lines))
     return lines
 
@@ -296,11 +363,14 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "out")
     parser.add_argument("--quick", action="store_true", help="fewer steps and tolerances (a smoke run)")
+    parser.add_argument("--only", default="", help="run only the scenarios whose name starts with this")
     args = parser.parse_args(argv)
     os.environ.setdefault("NUMBA_CACHE_DIR", str(ROOT / ".cache" / "numba"))
     started = time.perf_counter()
     results = {}
     for scenario in SCENARIOS:
+        if not scenario.name.startswith(args.only):
+            continue
         print(f"{scenario.name}: model {scenario.model}, t = {scenario.horizon:g}, {scenario.parameters}", flush=True)
         results[scenario.name] = measure(scenario, args.quick, lambda s: print(s, flush=True))
     total = time.perf_counter() - started

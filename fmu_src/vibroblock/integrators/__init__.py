@@ -42,7 +42,7 @@ from typing import Callable
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import typeof, types  # noqa: E402
 
-from . import event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
+from . import adaptive, event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
 from .fixed_step import NON_FINITE, OK, STOP
 
 
@@ -88,6 +88,24 @@ def _implicit_contact_limit(p: dict, model: str, name: str) -> str | None:
 
 
 def _no_limit(p: dict, model: str, name: str) -> str | None:
+    return None
+
+
+# Tolerances the adaptive integrator accepts: below RTOL_MIN the local error cannot be
+# told from rounding; above RTOL_MAX the error estimate no longer bounds anything.
+RTOL_MIN, RTOL_MAX = 1e-13, 1e-2
+
+
+def _tolerances(p: dict, model: str, name: str) -> str | None:
+    """The adaptive integrator's dt is only its storage grid; its accuracy is rtol, atol."""
+    rtol, atol = p["rtol"], p["atol"]
+    if not RTOL_MIN <= rtol <= RTOL_MAX:
+        return (f"rtol = {rtol:g} is not admissible with {name}: the relative tolerance must lie in "
+                f"[{RTOL_MIN:g}, {RTOL_MAX:g}] (below, rounding dominates the local error; above, the error "
+                "estimate bounds nothing)")
+    if not 1e-300 < atol <= 1.0:
+        return (f"atol = {atol:g} is not admissible with {name}: the absolute tolerance must lie in (1e-300, 1] "
+                "(lengths in delta_0 and velocities in delta_0/tau_0, whose natural scale is 1)")
     return None
 
 
@@ -161,6 +179,21 @@ _IMPLICIT_STATUSES = {
         "({integrator}); the state at t = {t:g} is kept. Reduce dt."),
 }
 
+_ADAPTIVE_STATUSES = {
+    adaptive.STEP_TOO_SMALL: (
+        "the error-controlled step fell to rounding level between t = {t:g} and t = {t_end:g} ({integrator}): "
+        "the tolerances cannot be met there; the state at t = {t:g} is kept. Loosen rtol/atol or check the "
+        "parameters for extreme values."),
+    adaptive.TOO_MANY_STEPS: (
+        f"more than {adaptive.MAX_STEPS} internal steps between t = {{t:g}} and t = {{t_end:g}} ({{integrator}}; "
+        "some 20 s of work): a master must not be held that long; the state at t = {t:g} is kept. Use "
+        "shorter communication steps or looser rtol/atol (resolving each plate period over a long stick is "
+        "what costs)."),
+    adaptive.TOO_MANY_EVENTS: (
+        f"more than {adaptive.MAX_IMMEDIATE} contact or friction switches in a row at one instant near t = "
+        "{t:g} ({integrator}): the contact chatters; the state at t = {t:g} is kept."),
+}
+
 _RECORDS = (
     _fixed_step(0, "symplectic_euler", symplectic_euler,
                 summary="the paper's first-order scheme (semi-implicit Euler)", models="*", force_evaluations=1,
@@ -173,6 +206,9 @@ _RECORDS = (
     _fixed_step(3, "implicit_contact", implicit_contact,
                 summary="contact spring-dashpots in closed form, stiff-stable", models="*", force_evaluations=2,
                 check_step=_implicit_contact_limit, statuses=_IMPLICIT_STATUSES),
+    Integrator(4, "adaptive", "error-controlled Rosenbrock (RODAS4) steps with located events, stiff-stable",
+               models="*", force_evaluations=0, check_step=_tolerances, advance=adaptive.advance,
+               observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False),
 )
 INTEGRATOR_RECORDS: dict[str, Integrator] = {r.name: r for r in _RECORDS}
 BY_ID: dict[int, Integrator] = {r.id: r for r in _RECORDS}

@@ -27,14 +27,14 @@ def cases():
 
 
 def make(model, keywords, **more):
-    dt = 1e-2 if keywords.get("integrator") in ("event_driven", "implicit_contact") else 4e-3
+    dt = 1e-2 if keywords.get("integrator") in ("event_driven", "implicit_contact", "adaptive") else 4e-3
     return Block(model, **{"dt": dt, **SCALED, **keywords, **more})
 
 
 def test_registry_ids_and_names_are_unique_and_public_ids_are_stable():
     assert len({r.id for r in BY_ID.values()}) == len(BY_ID)
     assert {r.name: r.id for r in INTEGRATOR_RECORDS.values()} == {
-        "symplectic_euler": 0, "rk4": 1, "event_driven": 2, "implicit_contact": 3}  # FMU values never change
+        "symplectic_euler": 0, "rk4": 1, "event_driven": 2, "implicit_contact": 3, "adaptive": 4}  # FMU values never change
 
 
 @pytest.mark.parametrize("record, model, keywords", list(cases()))

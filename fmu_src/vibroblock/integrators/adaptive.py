@@ -1,0 +1,714 @@
+"""``adaptive`` (id 4, every model): error-controlled, stiff-stable steps with located events.
+
+Method.  A Rosenbrock method of order 4 with an embedded order-3 estimate (RODAS4,
+Hairer & Wanner, Solving ODEs II, Sec. IV.7: six stages, L-stable and stiffly
+accurate, so a step far longer than the contact's and the friction spring's periods
+damps what has rung down instead of amplifying it) on the state (x, z, vx, vz, F) and
+the quadratures (phi, work, dissipation, normal-spring energy), which ride along as
+extra components that feed nothing back.  Every step solves five linear systems with
+one LU factorisation of (I/(h gamma) - J); J is the Jacobian of the forces on the
+five-dimensional state by central differences (so any variant or formulation that
+``dynamics`` computes is differentiated the same way), and the explicit time
+dependence (plate, drive's far end) enters through a difference quotient in t.  The
+step is accepted when the weighted RMS of the embedded error over the five state
+components is <= 1 (weights atol + rtol max(|y0|, |y1|)); the next step is
+h 0.9 err^(-1/4), within [0.2, 6] h.  While the plate moves harmonically a step spans
+at most CYCLE_FRACTION of its period, so no landing or grazing contact is stepped over
+unseen; a long stick without vibration is crossed in steps growing sixfold each.
+
+Dense output.  Each step carries RODAS4's third-order interpolant (from stages 1-5).
+
+Regimes and events (N: the contact force k_n delta - gamma_n u_n, continued across
+delta = 0 within a contact phase; B = mu_s N, the Coulomb bound):
+
+==========  ===========================  =====================================
+regime      event (value crosses 0)      after the event
+==========  ===========================  =====================================
+flight      delta rises through 0        contact: loaded if B > 0, else held
+loaded      delta falls through 0        flight, F = 0 (k_t F^2/2 dissipated)
+            B - k_t F or B + k_t F       Coulomb reset: F = 0, counted if F != 0;
+            falls through 0              loaded if B > 0, else held
+held        delta falls through 0        flight
+(F = 0)     B rises through 0            loaded (F restarts from 0)
+cascade     delta falls through 0        flight
+(F = 0)     B falls through 0            held
+==========  ===========================  =====================================
+
+A reset that follows the previous one within CASCADE_GAP ends in the cascade regime
+(the dashpot pulling the block out makes resets accumulate at the zero of N; the
+spring is held at zero from there until N has crossed zero, the cascade's limit).
+
+Location.  After an accepted step, the event values are checked on its interpolant at
+EVENT_SAMPLES points; in the first sub-interval where one changes sign, the earliest
+root of the interpolant is the first guess, and the switch time is then refined by
+regula falsi (Illinois) on full Rosenbrock steps from the step's start, until the
+bracket is shorter than EVENT_TOL.  The state is restarted from the far end of that
+bracket -- the full-order step to within EVENT_TOL after the true zero, on the far side
+-- and the reset rule is applied there, not at a step's end.
+
+Grid.  As ``event_driven``: dt only sets the grid on which the state is stored; a call
+integrates from t0 + n dt to t0 + (n + n_steps) dt.  Splits agree to the tolerances
+(the step sequence depends on where a run stops), not bit for bit.
+"""
+import math
+
+import numpy as np
+from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import literally, njit
+
+from ..dynamics import contact, energy_rates, force, plate_motion
+from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_PHASE_STEP, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
+                      D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, O_CONTACT, O_COS,
+                      O_DISSIPATED, O_E_NORMAL, O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX,
+                      O_VZ, O_WORK, O_X, O_Z, P_ATOL, P_GN, P_KN, P_KT, P_M, P_MUS, P_RTOL, P_VD, Y_DISSIPATED,
+                      Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+
+# Statuses (negative: failure, the arrays untouched).
+OK = 0
+NON_FINITE = -1
+STEP_TOO_SMALL = -2
+TOO_MANY_STEPS = -3
+TOO_MANY_EVENTS = -4
+
+# Largest step while the plate moves harmonically, as a fraction of its period.
+CYCLE_FRACTION = 1.0 / 16.0
+# Points of each step's interpolant at which the event values are checked.
+EVENT_SAMPLES = 4
+# Switch times are located to this (tau_0) after the true zero.
+EVENT_TOL = 1e-12
+# Resets closer together than this (tau_0) are the accumulation before a zero of N.
+CASCADE_GAP = 1e-9
+# Internal steps (accepted + rejected) one call may take: ~20-30 s on one core.
+MAX_STEPS = 1 << 24
+# Events in a row without the time moving by more than EVENT_TOL before the run stops.
+MAX_IMMEDIATE = 64
+# Step-size control.
+SAFETY, GROW, SHRINK = 0.9, 6.0, 0.2
+# Leaps across the error estimate's hump: a lightly damped mode (the friction spring
+# rings for 2m/gamma_t ~ 1e4) whose amplitude the local errors keep at the tolerance
+# makes the estimate grow with h while h |lambda| ~ 1-1000 and vanish beyond (both
+# embedded solutions damp it).  After LEAP_AFTER accepted steps in a row that could not
+# grow, a step LEAP times longer is tried; it is kept only if its own error estimate
+# passes (else it counts as rejected).
+LEAP_AFTER, LEAP = 8, 1e4
+
+# Regimes.
+FLIGHT, LOADED, HELD, CASCADE = 0, 1, 2, 3
+# Events.
+EV_NONE, EV_CONTACT, EV_DETACH, EV_RESET_PLUS, EV_RESET_MINUS, EV_REARM, EV_HOLD = range(7)
+
+# State vector of the integration: the five state components, then the quadratures.
+NS = 5
+NQ = 4
+NV = NS + NQ
+
+# RODAS4 (Hairer & Wanner, Sec. IV.7, Table 7.3): the transformed stages
+# (I/(h gamma) - J) k_i = f(t + c_i h, y + sum a_ij k_j) + sum (c_ij / h) k_j + h d_i f_t.
+GAMMA = 0.25
+STAGE_C = np.array([0.0, 0.386, 0.21, 0.63, 1.0, 1.0])
+STAGE_D = np.array([0.25, -0.1043, 0.1035, -0.0362, 0.0, 0.0])
+STAGE_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [1.544, 0.0, 0.0, 0.0, 0.0],
+    [0.9466785280815826, 0.2557011698983284, 0.0, 0.0, 0.0],
+    [3.314825187068521, 2.896124015972201, 0.9986419139977817, 0.0, 0.0],
+    [1.221224509226641, 6.019134481288629, 12.53708332932087, -0.6878860361058950, 0.0],
+    [1.221224509226641, 6.019134481288629, 12.53708332932087, -0.6878860361058950, 1.0]])
+STAGE_CC = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [-5.6688, 0.0, 0.0, 0.0, 0.0],
+    [-2.430093356833875, -0.2063599157091915, 0.0, 0.0, 0.0],
+    [-0.1073529058151375, -9.594562251023355, -20.47028614809616, 0.0, 0.0],
+    [7.496443313967647, -10.24680431464352, -33.99990352819905, 11.70890893206160, 0.0],
+    [8.083246795921522, -7.981132988064893, -31.52159432874371, 16.31930543123136, -6.058818238834054]])
+# Dense output y(s) = (1 - s) y0 + s (y1 + (1 - s) (w2 + s w3)), w_r = sum_j DENSE[r, j] k_j.
+DENSE = np.array([
+    [10.12623508344586, -7.487995877610167, -34.80091861555747, -7.992771707568823, 1.025137723295662],
+    [-0.6762803392801253, 6.087714651680015, 16.43084320892478, 24.76722511418386, -6.594389125716872]])
+
+EPS = 2.220446049250313e-16
+JAC_STEP = 1e-5  # relative increment of the central differences (~eps^(1/3))
+
+
+# --------------------------------------------------------------------------- physics
+@njit(inline="always")
+def _plate(drv, cnt, n0, u):
+    """Plate height and velocity at local time u after grid step n0."""
+    phase = drv[D_PHASE] + drv[D_OMEGA] * (drv[D_DT] * (n0 - cnt[C_PHASE_STEP]) + u)
+    tau = (drv[D_T0] - drv[D_EXT_T]) + n0 * drv[D_DT] + u
+    return plate_motion(drv[D_AMP], drv[D_OMEGA], math.sin(phase), math.cos(phase), drv[D_EXT_Z], drv[D_EXT_V],
+                        drv[D_EXT_A], tau)
+
+
+@njit(inline="always")
+def _rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
+    """Rates of the state and the quadratures in one regime.  Within a contact phase the
+    normal force k_n delta - gamma_n u_n is continued across delta = 0 (the event, not the
+    force, ends the phase), so a step may straddle a switch smoothly."""
+    x, z, vx, vz = v[0], v[1], v[2], v[3]
+    shear = v[4] if regime == LOADED else 0.0
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz, pv, prm)
+    if regime == FLIGHT:
+        normal = 0.0
+        gate = -1.0
+    else:
+        normal = prm[P_KN] * pen - prm[P_GN] * u_n
+        gate = 1.0
+    fx, fz = force(kind, x, t, gate, normal, u_t, cos_a, sin_a, shear, prm)
+    inv_m = 1.0 / prm[P_M]
+    out[0], out[1], out[2], out[3] = vx, vz, fx * inv_m, fz * inv_m
+    out[4] = u_t if regime == LOADED else 0.0
+    drift = vx - prm[P_VD]
+    out[5] = drift * drift
+    if track_energy:
+        # The rates are gated on delta > 0; within a contact phase they are continued like
+        # the force: gate open, and the normal spring's power, which is linear in delta,
+        # scaled from delta = 1 (so that the quadratures' rows of the Jacobian have no kink).
+        work, dissipation, storage = energy_rates(kind, x, vx, vz, t, gate, u_n, u_t, cos_a, sin_a, normal, shear,
+                                                  pv, prm)
+        out[6], out[7], out[8] = work, dissipation, storage * pen if regime != FLIGHT else 0.0
+    else:
+        out[6] = out[7] = out[8] = 0.0
+
+
+@njit(inline="always")
+def _bound(kind, v, pz, pv, prm):
+    """Penetration and the Coulomb bound mu_s N (N continued across delta = 0)."""
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, v[0], v[1], v[2], v[3], pz, pv, prm)
+    return pen, prm[P_MUS] * (prm[P_KN] * pen - prm[P_GN] * u_n)
+
+
+@njit(inline="always")
+def _event_value(event, pen, bound, spring):
+    """Positive before the switch, negative once it has happened."""
+    if event == EV_CONTACT:
+        return -pen
+    if event == EV_DETACH:
+        return pen
+    if event == EV_RESET_PLUS:
+        return bound - spring
+    if event == EV_RESET_MINUS:
+        return bound + spring
+    if event == EV_REARM:
+        return -bound
+    return bound  # EV_HOLD
+
+
+@njit(inline="always")
+def _events_of(regime):
+    """The events a regime watches: (first, count) in the order contact/detach, resets, N."""
+    if regime == FLIGHT:
+        return EV_CONTACT, 1
+    if regime == LOADED:
+        return EV_DETACH, 3
+    return EV_DETACH, 2
+
+
+@njit(inline="always")
+def _event_at(regime, i):
+    if regime == FLIGHT:
+        return EV_CONTACT
+    if i == 0:
+        return EV_DETACH
+    if regime == LOADED:
+        return EV_RESET_PLUS if i == 1 else EV_RESET_MINUS
+    return EV_REARM if regime == HELD else EV_HOLD
+
+
+@njit(inline="always")
+def _value(kind, regime, i, v, pz, pv, prm):
+    pen, bound = _bound(kind, v, pz, pv, prm)
+    return _event_value(_event_at(regime, i), pen, bound, prm[P_KT] * v[4])
+
+
+# --------------------------------------------------------------------------- linear algebra
+@njit(inline="always")
+def _factor(jac, c, lu, piv):
+    """LU (partial pivoting) of c I - J on the state block; False if singular."""
+    for i in range(NS):
+        for j in range(NS):
+            lu[i, j] = -jac[i, j]
+        lu[i, i] += c
+    for k in range(NS):
+        p = k
+        best = abs(lu[k, k])
+        for i in range(k + 1, NS):
+            if abs(lu[i, k]) > best:
+                best, p = abs(lu[i, k]), i
+        piv[k] = p
+        if best == 0.0 or not math.isfinite(best):
+            return False
+        if p != k:
+            for j in range(NS):
+                lu[k, j], lu[p, j] = lu[p, j], lu[k, j]
+        inv = 1.0 / lu[k, k]
+        for i in range(k + 1, NS):
+            lu[i, k] *= inv
+            f = lu[i, k]
+            for j in range(k + 1, NS):
+                lu[i, j] -= f * lu[k, j]
+    return True
+
+
+@njit(inline="always")
+def _solve(jac, c, lu, piv, r):
+    """Solve (c I - J) k = r in place; the quadrature rows follow from the state's
+    (their columns of J are zero)."""
+    for k in range(NS):
+        p = piv[k]
+        if p != k:
+            r[k], r[p] = r[p], r[k]
+        for i in range(k + 1, NS):
+            r[i] -= lu[i, k] * r[k]
+    for k in range(NS - 1, -1, -1):
+        s = r[k]
+        for j in range(k + 1, NS):
+            s -= lu[k, j] * r[j]
+        r[k] = s / lu[k, k]
+    inv_c = 1.0 / c
+    for i in range(NS, NV):
+        s = r[i]
+        for j in range(NS):
+            s += jac[i, j] * r[j]
+        r[i] = s * inv_c
+
+
+# --------------------------------------------------------------------------- one step
+@njit(inline="always")
+def _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, jac, ft, work):
+    """f at the step's start, its Jacobian on the state block (central differences) and
+    its explicit time derivative (a difference quotient over an exactly representable
+    increment)."""
+    pz, pv = _plate(drv, cnt, n0, u)
+    _rhs(kind, regime, v, t_abs, pz, pv, prm, track_energy, f0)
+    probe = work[0]
+    plus, minus = work[1], work[2]
+    for i in range(NV):
+        probe[i] = v[i]
+    for j in range(NS):
+        step = JAC_STEP * max(1.0, abs(v[j]))
+        probe[j] = v[j] + step
+        up = probe[j] - v[j]
+        _rhs(kind, regime, probe, t_abs, pz, pv, prm, track_energy, plus)
+        probe[j] = v[j] - step
+        down = v[j] - probe[j]
+        _rhs(kind, regime, probe, t_abs, pz, pv, prm, track_energy, minus)
+        probe[j] = v[j]
+        inv = 1.0 / (up + down)
+        for i in range(NV):
+            jac[i, j] = (plus[i] - minus[i]) * inv
+    # time: the increment is what t_abs + dt_probe - t_abs really is
+    scale = 1.0
+    if drv[D_OMEGA] > 0.0 and drv[D_AMP] != 0.0:
+        scale = min(1.0, 1.0 / drv[D_OMEGA])
+    dt_probe = max(1e-3 * scale, 64.0 * EPS * abs(t_abs))
+    t_up = t_abs + dt_probe
+    t_down = t_abs - dt_probe
+    span = t_up - t_down
+    pz1, pv1 = _plate(drv, cnt, n0, u + (t_up - t_abs))
+    _rhs(kind, regime, v, t_up, pz1, pv1, prm, track_energy, plus)
+    pz0, pv0 = _plate(drv, cnt, n0, u - (t_abs - t_down))
+    _rhs(kind, regime, v, t_down, pz0, pv0, prm, track_energy, minus)
+    inv = 1.0 / span
+    for i in range(NV):
+        ft[i] = (plus[i] - minus[i]) * inv
+
+
+@njit(inline="always")
+def _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, stage,
+                rate, out):
+    """One RODAS4 step of length h from v (quadratures of v are 0): fills ``out`` with the
+    new state and the quadrature increments and ``k`` with the stages; returns the
+    weighted RMS error of the state (inf if the matrix is singular)."""
+    c = 1.0 / (h * GAMMA)
+    if not _factor(jac, c, lu, piv):
+        return math.inf
+    for s in range(6):
+        if s == 0:
+            for i in range(NV):
+                rate[i] = f0[i]
+        else:
+            for i in range(NV):
+                acc = v[i]
+                for j in range(s):
+                    acc += STAGE_A[s, j] * k[j, i]
+                stage[i] = acc
+            pz, pv = _plate(drv, cnt, n0, u + STAGE_C[s] * h)
+            _rhs(kind, regime, stage, t_abs + STAGE_C[s] * h, pz, pv, prm, track_energy, rate)
+        inv_h = 1.0 / h
+        for i in range(NV):
+            acc = rate[i] + h * STAGE_D[s] * ft[i]
+            for j in range(s):
+                acc += STAGE_CC[s, j] * inv_h * k[j, i]
+            k[s, i] = acc
+        _solve(jac, c, lu, piv, k[s])
+    err = 0.0
+    for i in range(NV):
+        out[i] = stage[i] + k[5, i]  # stiffly accurate: the last stage's argument plus k6
+    rtol, atol = prm[P_RTOL], prm[P_ATOL]
+    for i in range(NS):
+        weight = atol + rtol * max(abs(v[i]), abs(out[i]))
+        e = k[5, i] / weight
+        err += e * e
+    err = math.sqrt(err / NS)
+    if not math.isfinite(err):
+        return math.inf
+    return err
+
+
+@njit(inline="always")
+def _dense(v, out, k, s, res):
+    """The step's interpolant at fraction s of the step (state components)."""
+    for i in range(NS):
+        w2 = 0.0
+        w3 = 0.0
+        for j in range(5):
+            w2 += DENSE[0, j] * k[j, i]
+            w3 += DENSE[1, j] * k[j, i]
+        res[i] = (1.0 - s) * v[i] + s * (out[i] + (1.0 - s) * (w2 + s * w3))
+
+
+# --------------------------------------------------------------------------- regimes
+@njit(inline="always")
+def _regime_after_contact(bound):
+    return LOADED if bound > 0.0 else HELD
+
+
+@njit(cache=True)
+def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
+    """Integrate from grid step n0 (state y) over local time u_end.  Writes the final state
+    to ``out`` (layout of y), the slip count to costs[0] and the cost counters (accepted,
+    rejected, events, Jacobians) to costs[1:5].  Returns OK or a negative status."""
+    kt = prm[P_KT]
+    half_kt = 0.5 * kt
+    t_base = drv[D_T0] + n0 * drv[D_DT]
+    v = np.zeros(NV)
+    v[0], v[1], v[2], v[3], v[4] = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    phi, phi_c = y[Y_PHI], y[Y_PHI_C]
+    work_sum, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
+    slips = cnt[C_SLIPS]
+    accepted = rejected = events = jacobians = 0
+
+    f0 = np.zeros(NV)
+    ft = np.zeros(NV)
+    jac = np.zeros((NV, NS))
+    lu = np.zeros((NS, NS))
+    piv = np.zeros(NS, dtype=np.int64)
+    k = np.zeros((6, NV))
+    stage = np.zeros(NV)
+    rate = np.zeros(NV)
+    trial = np.zeros(NV)
+    best = np.zeros(NV)
+    probe = np.zeros(NV)
+    scratch = np.zeros((3, NV))
+
+    # The regime of the stored state, with the friction rule applied to it.
+    pz, pv = _plate(drv, cnt, n0, 0.0)
+    pen, bound = _bound(kind, v, pz, pv, prm)
+    if pen > 0.0:
+        if abs(kt * v[4]) >= bound:
+            if v[4] != 0.0:
+                slips += 1
+                dissipated += half_kt * v[4] * v[4]
+            v[4] = 0.0
+        regime = _regime_after_contact(bound)
+    else:
+        if v[4] != 0.0:
+            dissipated += half_kt * v[4] * v[4]
+            v[4] = 0.0
+        regime = FLIGHT
+
+    cap = math.inf
+    if drv[D_OMEGA] > 0.0 and drv[D_AMP] != 0.0:
+        cap = CYCLE_FRACTION * 2.0 * math.pi / drv[D_OMEGA]
+    rtol = prm[P_RTOL]
+    h = min(cap, 0.1 * rtol ** 0.25)
+    u = 0.0
+    last_reset = -math.inf
+    immediate = 0
+    stagnant = 0
+    status = OK
+    fresh = False  # the linearisation at (u, v, regime) is current
+    while u < u_end:
+        if accepted + rejected >= MAX_STEPS:
+            status = TOO_MANY_STEPS
+            break
+        t_abs = t_base + u
+        if not fresh:
+            _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, jac, ft, scratch)
+            jacobians += 1
+            fresh = True
+        remaining = u_end - u
+        err = math.inf
+        if stagnant >= LEAP_AFTER and LEAP * h < cap:
+            stagnant = 0
+            h_leap = min(LEAP * h, remaining)
+            err = _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h_leap, prm, track_energy, f0, jac, ft, lu,
+                              piv, k, stage, rate, trial)
+            if err <= 1.0:
+                h = h_leap
+            else:
+                rejected += 1
+        last = h >= remaining
+        if last:
+            h = remaining
+        if not err <= 1.0:
+            err = _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k,
+                              stage, rate, trial)
+        if not err <= 1.0:
+            rejected += 1
+            stagnant = 0
+            h *= SHRINK if not math.isfinite(err) else max(SHRINK, SAFETY * err ** -0.25)
+            if h <= 16.0 * EPS * max(1.0, abs(t_abs)):
+                status = STEP_TOO_SMALL
+                break
+            continue
+        accepted += 1
+        growth = min(GROW, max(SHRINK, SAFETY * (max(err, 1e-12) ** -0.25)))
+        stagnant = stagnant + 1 if growth < 2.0 else 0
+        h_next = h * growth
+
+        # Events: the first sub-interval of the interpolant in which a value changes sign.
+        first_event, n_events = _events_of(regime)
+        event = EV_NONE
+        s_hi, s_sample = 1.0, 1.0
+        previous = 0.0
+        for sample in range(1, EVENT_SAMPLES + 1):
+            s = sample / EVENT_SAMPLES
+            if sample == EVENT_SAMPLES:
+                for i in range(NS):
+                    probe[i] = trial[i]
+            else:
+                _dense(v, trial, k, s, probe)
+            pz, pv = _plate(drv, cnt, n0, u + s * h)
+            earliest = math.inf
+            for e in range(n_events):
+                if _value(kind, regime, e, probe, pz, pv, prm) < 0.0:
+                    # the interpolant's root in (previous, s): a few regula falsi iterations
+                    a, b = previous, s
+                    _dense(v, trial, k, a, best)
+                    pza, pva = _plate(drv, cnt, n0, u + a * h)
+                    ga = _value(kind, regime, e, best, pza, pva, prm)
+                    if a == 0.0:
+                        ga = max(ga, 0.0)
+                    gb = _value(kind, regime, e, probe, pz, pv, prm)
+                    root = b
+                    if ga > 0.0:
+                        for _ in range(40):
+                            root = b - gb * (b - a) / (gb - ga)
+                            if not (a < root < b):
+                                root = 0.5 * (a + b)
+                            _dense(v, trial, k, root, best)
+                            pzr, pvr = _plate(drv, cnt, n0, u + root * h)
+                            gr = _value(kind, regime, e, best, pzr, pvr, prm)
+                            if gr < 0.0:
+                                b, gb = root, gr
+                                ga *= 0.5
+                            else:
+                                a, ga = root, gr
+                                gb *= 0.5
+                            if (b - a) * h <= EVENT_TOL:
+                                break
+                        root = b
+                    else:
+                        root = a
+                    if root < earliest:
+                        earliest = root
+                        event = _event_at(regime, e)
+            if event != EV_NONE:
+                s_hi, s_sample = earliest, s
+                break
+            previous = s
+
+        if event == EV_NONE:
+            for i in range(NS):
+                v[i] = trial[i]
+            phi, phi_c = _kahan(phi, phi_c, trial[5])
+            work_sum += trial[6]
+            dissipated += trial[7]
+            e_normal += trial[8]
+            u = u_end if last else u + h
+            fresh = False
+            h = min(h_next, cap)
+            immediate = 0
+            continue
+
+        # Refine the switch on full steps from the step's start: find a step length whose
+        # value is past zero (the interpolant's root, the sample that showed the sign
+        # change, the whole step), then regula falsi (Illinois) between it and the last
+        # length short of zero.
+        e_index = 0
+        for e in range(n_events):
+            if _event_at(regime, e) == event:
+                e_index = e
+        tol = max(EVENT_TOL, 4.0 * EPS * (abs(t_abs) + h))
+        pz, pv = _plate(drv, cnt, n0, u)
+        lo, g_lo = 0.0, max(_value(kind, regime, e_index, v, pz, pv, prm), 0.0)
+        hi, g_hi = -1.0, 0.0
+        for attempt in range(3):
+            length = s_hi * h if attempt == 0 else (s_sample * h if attempt == 1 else h)
+            if length <= lo:
+                continue
+            if attempt == 2:
+                for i in range(NV):
+                    probe[i] = trial[i]
+            else:
+                _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, length, prm, track_energy, f0, jac, ft, lu,
+                            piv, k, stage, rate, probe)
+            pz, pv = _plate(drv, cnt, n0, u + length)
+            g = _value(kind, regime, e_index, probe, pz, pv, prm)
+            if g < 0.0:
+                hi, g_hi = length, g
+                for i in range(NV):
+                    best[i] = probe[i]
+                break
+            lo, g_lo = length, g
+        if hi < 0.0:
+            # The value dipped below zero and back within the step on the interpolant
+            # only: the full steps see no switch (a graze within the tolerances).
+            for i in range(NS):
+                v[i] = trial[i]
+            phi, phi_c = _kahan(phi, phi_c, trial[5])
+            work_sum += trial[6]
+            dissipated += trial[7]
+            e_normal += trial[8]
+            u = u_end if last else u + h
+            fresh = False
+            h = min(h_next, cap)
+            continue
+        side = 0
+        for iteration in range(100):
+            if hi - lo <= tol:
+                break
+            guess = hi - g_hi * (hi - lo) / (g_hi - g_lo) if g_lo > g_hi else 0.5 * (lo + hi)
+            if not (lo < guess < hi):
+                guess = 0.5 * (lo + hi)
+                if not (lo < guess < hi):
+                    break
+            _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, guess, prm, track_energy, f0, jac, ft, lu, piv, k,
+                        stage, rate, probe)
+            pz, pv = _plate(drv, cnt, n0, u + guess)
+            g = _value(kind, regime, e_index, probe, pz, pv, prm)
+            if g < 0.0:
+                hi, g_hi = guess, g
+                for i in range(NV):
+                    best[i] = probe[i]
+                if side == -1:
+                    g_lo *= 0.5
+                side = -1
+            else:
+                lo, g_lo = guess, g
+                if side == 1:
+                    g_hi *= 0.5
+                side = 1
+        # Restart at the switch.
+        for i in range(NS):
+            v[i] = best[i]
+        phi, phi_c = _kahan(phi, phi_c, best[5])
+        work_sum += best[6]
+        dissipated += best[7]
+        e_normal += best[8]
+        if hi >= u_end - u:
+            u = u_end
+        else:
+            u += hi
+        events += 1
+        if hi <= EVENT_TOL:
+            immediate += 1
+            if immediate > MAX_IMMEDIATE:
+                status = TOO_MANY_EVENTS
+                break
+        else:
+            immediate = 0
+        pz, pv = _plate(drv, cnt, n0, u)
+        pen, bound = _bound(kind, v, pz, pv, prm)
+        if event == EV_CONTACT:
+            v[4] = 0.0
+            regime = _regime_after_contact(bound)
+        elif event == EV_DETACH:
+            dissipated += half_kt * v[4] * v[4]
+            v[4] = 0.0
+            regime = FLIGHT
+        elif event == EV_RESET_PLUS or event == EV_RESET_MINUS:
+            if v[4] != 0.0:
+                slips += 1
+                dissipated += half_kt * v[4] * v[4]
+            v[4] = 0.0
+            if bound > 0.0:
+                regime = CASCADE if u - last_reset < CASCADE_GAP else LOADED
+            else:
+                regime = HELD
+            last_reset = u
+        elif event == EV_REARM:
+            v[4] = 0.0
+            regime = LOADED
+        else:  # EV_HOLD: the cascade's limit, N reached zero
+            regime = HELD
+        fresh = False
+        h = min(max(h_next, h), cap)
+        if not math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4]):
+            status = NON_FINITE
+            break
+    if status == OK and not math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4] + phi + work_sum + dissipated):
+        status = NON_FINITE
+    out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F] = v[0], v[1], v[2], v[3], v[4]
+    out[Y_PHI], out[Y_PHI_C] = phi, phi_c
+    out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL] = work_sum, dissipated, e_normal
+    costs[0], costs[1], costs[2], costs[3], costs[4] = slips, accepted, rejected, events, jacobians
+    return status
+
+
+@njit(inline="always")
+def _kahan(total, compensation, value):
+    corrected = value - compensation
+    new_total = total + corrected
+    return new_total, (new_total - total) - corrected
+
+
+@njit(cache=True)
+def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
+    """Advance by n_steps grid steps (see the module doc): the end time
+    t0 + (n + n_steps) dt is reached by error-controlled steps whatever n_steps is.
+    Returns 0, or a negative status with the arrays untouched."""
+    kind = literally(kind)
+    out = y.copy()
+    costs = np.zeros(5, dtype=np.int64)
+    n = cnt[C_STEP]
+    status = _evolve(kind, y, cnt, drv, prm, n, n_steps * drv[D_DT], track_energy, out, costs)
+    if status < 0:
+        return status
+    y[:] = out
+    cnt[C_STEP] = n + n_steps
+    cnt[C_SLIPS] = costs[0]
+    cnt[C_ACCEPTED] += costs[1]
+    cnt[C_REJECTED] += costs[2]
+    cnt[C_EVENTS] += costs[3]
+    cnt[C_JACOBIANS] += costs[4]
+    return status
+
+
+@njit(cache=True)
+def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
+    """Fill ``obs`` with the state at t_n + h (0 <= h < dt) by a short integration from
+    the grid state, without touching the stored state (layout of ``fixed_step.observe``)."""
+    kind = literally(kind)
+    n = cnt[C_STEP]
+    out = y.copy()
+    costs = np.zeros(5, dtype=np.int64)
+    slips = cnt[C_SLIPS]
+    if h > 0.0:
+        status = _evolve(kind, y, cnt, drv, prm, n, h, track_energy, out, costs)
+        if status < 0:
+            out[:] = math.nan
+        else:
+            slips = costs[0]
+    t = drv[D_T0] + n * drv[D_DT] + h
+    pz, pv = _plate(drv, cnt, n, h)
+    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], pz, pv, prm)
+    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F]
+    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, cos_a
+    obs[O_PHI], obs[O_SLIPS], obs[O_T] = out[Y_PHI], slips, t
+    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL]
+    obs[O_CONTACT] = 1.0 if pen > 0.0 else 0.0
+    obs[O_FRICTION] = -prm[P_KT] * out[Y_F] if pen > 0.0 else 0.0
+    return N_OBS

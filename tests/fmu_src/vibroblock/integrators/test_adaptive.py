@@ -1,0 +1,149 @@
+"""The adaptive integrator against the independent reference, event_driven, the physics of
+a long stick, and its own tolerances."""
+import math
+
+import pytest
+
+from vibroblock import Block
+from vibroblock.block import ModelError
+
+from harness import reference
+from harness.reference import Solver
+
+SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
+VALLEY_X = (-0.5 * math.pi + 0.005) / 0.02  # slope 0.1 of the paper's corrugation, near a valley
+TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+# name -> (parameters, horizon, initial_state, x_start offset).  Short horizons: the
+# bouncing runs stay non-chaotic; the drive spring starts stretched by 40 so that the
+# embedded block slips (Coulomb resets) within the horizon.
+SCENARIOS = {
+    "stick-slip": (dict(SCALED), 300.0, 0, -40.0),
+    "sub-threshold": (dict(SCALED, A=0.2, omega=0.8), 200.0, 2, 0.0),
+    "bouncing": (dict(SCALED, A=1.0, omega=0.8), 30.0, 2, 0.0),
+}
+
+
+def run(model, parameters, horizon, initial, x_start, **keywords):
+    block = Block(model, "adaptive", dt=1e-2, energy_balance=True, initial_state=initial, x_start=x_start,
+                  **parameters, **keywords)
+    block.start()
+    block.advance_to(horizon)
+    return block
+
+
+def error(out, ref):
+    """Largest of the errors of x (relative to max(|x|, 1)), z, vx, vz (delta_0, delta_0/tau_0) and phi
+    (relative)."""
+    return max(abs(out["x"] - ref.final("x")) / max(1.0, abs(ref.final("x"))), abs(out["z"] - ref.final("z")),
+               abs(out["vx"] - ref.final("vx")), abs(out["vz"] - ref.final("vz")),
+               abs(out["phi_integral"] / ref.final("phi") - 1.0))
+
+
+def scenario(model, name):
+    parameters, horizon, initial, offset = SCENARIOS[name]
+    x_start = offset + (0.0 if model == "A" else VALLEY_X)
+    return parameters, horizon, initial, x_start
+
+
+@pytest.mark.parametrize("model", "ABC")
+@pytest.mark.parametrize("name", list(SCENARIOS))
+def test_agrees_with_the_independent_reference(model, name):
+    parameters, horizon, initial, x_start = scenario(model, name)
+    ref = reference.simulate(model, parameters, horizon, solver=Solver.reference(1e-12), initial=initial,
+                             x_start=x_start)
+    block = run(model, parameters, horizon, initial, x_start, **TIGHT)
+    out = block.outputs()
+    assert error(out, ref) < 1e-7
+    assert out["slip_count"] == ref.slips  # every Coulomb reset, cascades included
+    assert out["contact"] == bool(ref["contact"][-1])
+    if name != "sub-threshold" or model != "A":
+        assert ref.slips > 0  # the scenario exercises the resets
+    energy = out["work_input"] ** 2 + out["energy_dissipated"] ** 2
+    assert abs(out["energy_residual"]) < 1e-8 * max(1.0, math.sqrt(energy))
+    counters = block.counters
+    assert counters["accepted"] > 0 and counters["jacobians"] >= counters["accepted"]
+    assert counters["events"] >= counters["resets"]
+
+
+@pytest.mark.parametrize("name", ["stick-slip", "sub-threshold", "bouncing"])
+def test_model_a_agrees_with_event_driven_to_1e_8(name):
+    parameters, horizon, initial, x_start = scenario("A", name)
+    exact = Block("A", "event_driven", dt=1e-2, energy_balance=True, initial_state=initial, x_start=x_start,
+                  **parameters)
+    exact.start()
+    exact.advance_to(horizon)
+    ref = exact.outputs()
+    out = run("A", parameters, horizon, initial, x_start, **TIGHT).outputs()
+    for key in ("x", "z", "vx", "vz", "penetration"):
+        assert abs(out[key] - ref[key]) < 1e-8 * max(1.0, abs(ref[key])), key
+    assert abs(out["phi_integral"] - ref["phi_integral"]) < 1e-8 * ref["phi_integral"]
+
+
+@pytest.mark.parametrize("model", "BC")
+def test_error_falls_with_rtol(model):
+    parameters, horizon, initial, x_start = scenario(model, "sub-threshold")
+    ref = reference.simulate(model, parameters, horizon, solver=Solver.reference(1e-12), initial=initial,
+                             x_start=x_start)
+    errors, costs = [], []
+    for rtol in (1e-5, 1e-7, 1e-9):
+        block = run(model, parameters, horizon, initial, x_start, rtol=rtol, atol=rtol * 1e-2)
+        errors.append(error(block.outputs(), ref))
+        costs.append(block.counters["accepted"])
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[2] < 1e-7
+    assert costs[0] < costs[1] < costs[2]
+
+
+def test_off_grid_outputs_come_from_a_short_integration():
+    """An output between grid points equals the one of a run whose grid hits that time."""
+    parameters, _, initial, x_start = scenario("B", "bouncing")
+    coarse = Block("B", "adaptive", dt=1.0, initial_state=initial, x_start=x_start, **parameters, **TIGHT)
+    fine = Block("B", "adaptive", dt=0.25, initial_state=initial, x_start=x_start, **parameters, **TIGHT)
+    for block in (coarse, fine):
+        block.start()
+        block.advance_to(12.75)
+    a, b = coarse.outputs(), fine.outputs()
+    assert coarse.grid_step == 12 and fine.grid_step == 51
+    for key in ("x", "z", "vx", "vz", "friction_force", "normal_force"):
+        assert a[key] == pytest.approx(b[key], rel=1e-7, abs=1e-8), key
+    assert a["contact"] == b["contact"] and a["slip_count"] == b["slip_count"]
+
+
+@pytest.mark.parametrize("model, keywords", [("A", {}), ("B", {"A_x": 0.0}), ("C", {"A_x": 0.0})])
+def test_a_long_stick_at_the_papers_parameters_costs_few_steps(model, keywords):
+    """No vibration, the paper's drive (A: k_d = 5e-4, V_d = 2e-5; B, C: 5e-6, 2e-4; flat
+    plate for B and C): the block creeps at V_S = V_d k_d / (k_t + k_d) for
+    t_stick = mu_s m g / (k_t V_S) = 5e7 (A) or 5e8 (B, C).  An explicit method is held to
+    steps of order 1 by the contact's and the spring's periods (6.3 and 11.9): 1e7-1e8
+    steps.  The L-stable steps grow once the start's ringing (amplitude ~ V_S / omega) has
+    died, so crossing 0.9 t_stick takes a few thousand steps."""
+    block = Block(model, "adaptive", dt=1.0, energy_balance=True, **keywords)
+    block.start()
+    p = block.parameters
+    creep = p["V_d"] * p["k_d"] / (p["k_t"] + p["k_d"])
+    stick = p["mu_s"] * p["m"] * 1.0 / (p["k_t"] * creep)
+    block.advance_to(0.9 * stick)
+    out = block.outputs()
+    counters = block.counters
+    assert out["slip_count"] == 0 and out["contact"]
+    assert out["vx"] == pytest.approx(creep, rel=1e-3)
+    # the spring holds 0.9 of the Coulomb bound: k_t F = 0.9 mu_s m g
+    assert p["k_t"] * block.y[4] == pytest.approx(0.9 * p["mu_s"], rel=1e-3)
+    assert counters["accepted"] + counters["rejected"] < 2e4 < 1e-3 * stick
+    drive_energy = 0.5 * p["k_d"] * (p["V_d"] * 0.9 * stick) ** 2
+    assert abs(out["energy_residual"]) < 1e-6 * drive_energy
+
+
+@pytest.mark.parametrize("name, value", [("rtol", 0.0), ("rtol", -1e-6), ("atol", 0.0), ("atol", math.nan)])
+def test_non_positive_tolerances_are_refused_when_set(name, value):
+    with pytest.raises(ModelError, match=f"{name} = .* must be a finite number > 0"):
+        Block("A", "adaptive", **{name: value})
+
+
+@pytest.mark.parametrize("name, value, allowed", [("rtol", 0.5, r"\[1e-13, 0.01\]"), ("rtol", 1e-16, r"\[1e-13"),
+                                                  ("atol", 10.0, r"\(1e-300, 1\]")])
+def test_tolerances_out_of_range_are_refused_at_start(name, value, allowed):
+    block = Block("A", "adaptive", **{name: value})
+    with pytest.raises(ModelError, match=f"{name} = .*adaptive.*{allowed}"):
+        block.start()
+    Block("A", "symplectic_euler", **{name: value}).start()  # the fixed-step schemes ignore them
