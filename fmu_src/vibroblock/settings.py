@@ -29,20 +29,6 @@ def _unsupported(record: Integrator, model: str) -> str:
             f"{', '.join(models)}, not model {model} ({record.summary}); choose another integrator")
 
 
-# Readings an integrator does not implement: integrator name -> why not (None: fine).
-UNSUPPORTED_READINGS = {
-    "implicit_contact": lambda r: (
-        "integrates the fixed-axes reading only (its closed-form contact flows, the frame's turning terms "
-        "and their energy accounting are written for a point in fixed axes), not formulation = 1 "
-        "(tangent_frame)" if r["formulation"] == 1 else
-        "follows the surface's frame in flight too (its flight segments are exact flows along the frozen "
-        "tangent), not flight = 1 (free)" if r["flight"] == 1 else None),
-    "event_driven": lambda r: (
-        "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 (applied_load)"
-        if r["coulomb_normal"] == 1 else None),
-}
-
-
 class Settings:
     """What a run is made of, each value checked as it is set."""
 
@@ -178,7 +164,7 @@ class Settings:
         record = integrator_record(self.integrator)
         if not record.supports(self.model):
             raise ModelError(_unsupported(record, self.model))
-        problem = UNSUPPORTED_READINGS.get(record.name, lambda r: None)(self.readings)
+        problem = record.unsupported_reading(self.readings)
         if problem:
             raise ModelError(f"the {record.name} integrator {problem}; choose symplectic_euler or rk4")
         problem = record.check_step(self.parameters, self.model, record.name)

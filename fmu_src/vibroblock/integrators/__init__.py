@@ -129,6 +129,8 @@ class Integrator:
     splits_bitwise: bool = True  # contract rule 3 holds bit for bit
     public: bool = True  # offered through the FMU's ``integrator`` parameter
     scheme: tuple | None = None  # (prepare, step) of a fixed-step scheme
+    # Why the integrator cannot run a reading (formulation, coulomb_normal, flight), or None.
+    unsupported_reading: Callable[[dict], str | None] = lambda readings: None
 
     def run_advance(self, kind: int, flags: int, y, cnt, drv, prm, n_steps: int, track_energy: bool) -> int:
         return _specialized(self.advance, kind, self.id, (flags, y, cnt, drv, prm, n_steps, bool(track_energy)))
@@ -202,13 +204,27 @@ _RECORDS = (
                 check_step=_spring_dashpot_limit(4.0)),
     Integrator(2, "event_driven", "exact flows with located events (model A only)", models="A",
                force_evaluations=0, check_step=_no_limit, advance=event_driven.advance,
-               observe=event_driven.observe, splits_bitwise=False),
+               observe=event_driven.observe, splits_bitwise=False,
+               unsupported_reading=lambda r: (
+                   "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 "
+                   "(applied_load)" if r["coulomb_normal"] == 1 else None)),
     _fixed_step(3, "implicit_contact", implicit_contact,
                 summary="contact spring-dashpots in closed form, stiff-stable", models="*", force_evaluations=2,
-                check_step=_implicit_contact_limit, statuses=_IMPLICIT_STATUSES),
+                check_step=_implicit_contact_limit, statuses=_IMPLICIT_STATUSES,
+                unsupported_reading=lambda r: (
+                    "integrates the fixed-axes reading only (its closed-form contact flows, the frame's turning "
+                    "terms and their energy accounting are written for a point in fixed axes), not formulation = 1 "
+                    "(tangent_frame)" if r["formulation"] == 1 else
+                    "follows the surface's frame in flight too (its flight segments are exact flows along the "
+                    "frozen tangent), not flight = 1 (free)" if r["flight"] == 1 else None)),
     Integrator(4, "adaptive", "error-controlled Rosenbrock (RODAS4) steps with located events, stiff-stable",
                models="*", force_evaluations=0, check_step=_tolerances, advance=adaptive.advance,
-               observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False),
+               observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False,
+               unsupported_reading=lambda r: (
+                   "runs the default reading only (fixed axes, contact-force Coulomb bound, surface flight): its "
+                   "Jacobian, events and reset rule are written for it, not "
+                   + ", ".join(f"{name} = {value}" for name, value in r.items() if value)
+                   if any(r.values()) else None)),
 )
 INTEGRATOR_RECORDS: dict[str, Integrator] = {r.name: r for r in _RECORDS}
 BY_ID: dict[int, Integrator] = {r.id: r for r in _RECORDS}
