@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import html
 import io
-import re
 
 ENV_VARIABLE = "VIBROBLOCK_PYTHON"  # build/python_runtime.c
 

@@ -18,9 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from pathlib import Path
 import sys
-
 from pathlib import Path
 
 from .settings import (PRESETS, InitialCondition, Integration, ObservableSettings, Parameters, PointSettings,

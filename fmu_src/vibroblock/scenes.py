@@ -39,12 +39,10 @@ from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import literally, njit
 
 from .dynamics import contact, friction_rule
-from .integrators.fixed_step import OK, STOP
+from .integrators.fixed_step import OK, STOP, record_observation
 from .integrators.plate import drive_sin_cos, phase_at_time, plate_at, plate_at_time
-from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED,
-                     O_E_NORMAL, O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X,
-                     O_Z, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI,
-                     Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M,
+                     P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .models import load, profile
 
 RIGID, FROZEN, COULOMB = 1, 2, 4
@@ -249,10 +247,5 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         normal = probe[6]
         in_contact = pen >= -ATTACHED_TOLERANCE * (1.0 + abs(z)) and normal > 0.0
     friction = probe[7] if coulomb else (-prm[P_KT] * shear if in_contact else 0.0)
-    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = x, z, vx, vz, shear
-    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, cos_a
-    obs[O_PHI], obs[O_SLIPS], obs[O_T] = phi, slips, t
-    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = work, dissipated, e_normal
-    obs[O_CONTACT] = 1.0 if in_contact else 0.0
-    obs[O_FRICTION] = friction
-    return N_OBS
+    return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,
+                              e_normal, in_contact, friction)

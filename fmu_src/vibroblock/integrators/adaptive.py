@@ -57,11 +57,11 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import literally, njit
 
 from ..dynamics import contact, energy_rates, force, plate_motion
+from .fixed_step import kahan_add, record_observation
 from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_PHASE_STEP, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
-                      D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, O_CONTACT, O_COS,
-                      O_DISSIPATED, O_E_NORMAL, O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX,
-                      O_VZ, O_WORK, O_X, O_Z, P_ATOL, P_GN, P_KN, P_KT, P_M, P_MUS, P_RTOL, P_VD, Y_DISSIPATED,
-                      Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+                      D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, P_ATOL, P_GN, P_KN, P_KT,
+                      P_M, P_MUS, P_RTOL, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK,
+                      Y_X, Y_Z)
 
 # Statuses (negative: failure, the arrays untouched).
 OK = 0
@@ -523,7 +523,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         if event == EV_NONE:
             for i in range(NS):
                 v[i] = trial[i]
-            phi, phi_c = _kahan(phi, phi_c, trial[5])
+            phi, phi_c = kahan_add(phi, phi_c, trial[5])
             work_sum += trial[6]
             dissipated += trial[7]
             e_normal += trial[8]
@@ -568,7 +568,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             # only: the full steps see no switch (a graze within the tolerances).
             for i in range(NS):
                 v[i] = trial[i]
-            phi, phi_c = _kahan(phi, phi_c, trial[5])
+            phi, phi_c = kahan_add(phi, phi_c, trial[5])
             work_sum += trial[6]
             dissipated += trial[7]
             e_normal += trial[8]
@@ -604,7 +604,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         # Restart at the switch.
         for i in range(NS):
             v[i] = best[i]
-        phi, phi_c = _kahan(phi, phi_c, best[5])
+        phi, phi_c = kahan_add(phi, phi_c, best[5])
         work_sum += best[6]
         dissipated += best[7]
         e_normal += best[8]
@@ -658,13 +658,6 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     return status
 
 
-@njit(inline="always")
-def _kahan(total, compensation, value):
-    corrected = value - compensation
-    new_total = total + corrected
-    return new_total, (new_total - total) - corrected
-
-
 @njit(cache=True)
 def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by n_steps grid steps (see the module doc): the end time
@@ -705,10 +698,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     t = drv[D_T0] + n * drv[D_DT] + h
     pz, pv = _plate(drv, cnt, n, h)
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], pz, pv, prm)
-    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F]
-    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, cos_a
-    obs[O_PHI], obs[O_SLIPS], obs[O_T] = out[Y_PHI], slips, t
-    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL]
-    obs[O_CONTACT] = 1.0 if pen > 0.0 else 0.0
-    obs[O_FRICTION] = -prm[P_KT] * out[Y_F] if pen > 0.0 else 0.0
+    record_observation(obs, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F], pen, normal, cos_a, out[Y_PHI], slips,
+                       t, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL], pen > 0.0,
+                       -prm[P_KT] * out[Y_F] if pen > 0.0 else 0.0)
     return N_OBS

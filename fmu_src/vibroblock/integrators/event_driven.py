@@ -65,11 +65,10 @@ import numpy as np
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
+from .fixed_step import record_observation
 from ..layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
-                     D_PHASE, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED,
-                     Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS, O_CONTACT, O_COS,
-                     O_DISSIPATED, O_E_NORMAL, O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T,
-                     O_VX, O_VZ, O_WORK, O_X, O_Z)
+                      D_PHASE, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL,
+                      Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS)
 
 # Events are located to this time (tau_0) past their true zero, or to 8 ulp of the time
 # since the segment began, whichever is larger.
@@ -982,10 +981,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     plate_v = drv[D_AMP] * om * math.cos(th) + drv[D_EXT_V] + drv[D_EXT_A] * tau_e
     pen = plate_z - out[Y_Z]
     normal = prm[P_KN] * pen - prm[P_GN] * (out[Y_VZ] - plate_v) if pen > 0.0 else 0.0
-    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F]
-    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, 1.0
-    obs[O_PHI], obs[O_SLIPS], obs[O_T] = out[Y_PHI], slips, t
-    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL]
-    obs[O_CONTACT] = 1.0 if pen > 0.0 else 0.0
-    obs[O_FRICTION] = -prm[P_KT] * out[Y_F] if pen > 0.0 else 0.0
+    record_observation(obs, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F], pen, normal, 1.0, out[Y_PHI], slips,
+                       t, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL], pen > 0.0,
+                       -prm[P_KT] * out[Y_F] if pen > 0.0 else 0.0)
     return N_OBS

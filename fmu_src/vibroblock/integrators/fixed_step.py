@@ -79,6 +79,19 @@ def kahan_add(total, compensation, value):
 
 
 @njit(inline="always")
+def record_observation(obs, x, z, vx, vz, shear, penetration, normal, cos_a, phi, slips, t, work, dissipated,
+                       e_normal, in_contact, friction):
+    """Fill the observation array (``layout.O_*``): the one layout every observe kernel returns."""
+    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = x, z, vx, vz, shear
+    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = penetration, normal, cos_a
+    obs[O_PHI], obs[O_SLIPS], obs[O_T] = phi, slips, t
+    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = work, dissipated, e_normal
+    obs[O_CONTACT] = 1.0 if in_contact else 0.0
+    obs[O_FRICTION] = friction
+    return N_OBS
+
+
+@njit(inline="always")
 def is_finite_state(x, z, vx, vz, shear):
     return math.isfinite(x + z + vx + vz + shear)
 
@@ -199,10 +212,5 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             e_normal += d_normal
         t += h
     pen, u_n, u_t, cos_a, sin_a, normal = state_contact
-    obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = x, z, vx, vz, shear
-    obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = pen, normal, cos_a
-    obs[O_PHI], obs[O_SLIPS], obs[O_T] = phi, slips, t
-    obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = work, dissipated, e_normal
-    obs[O_CONTACT] = 1.0 if pen > 0.0 else 0.0
-    obs[O_FRICTION] = -prm[P_KT] * shear if pen > 0.0 else 0.0
-    return N_OBS
+    return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,
+                              e_normal, pen > 0.0, -prm[P_KT] * shear if pen > 0.0 else 0.0)
