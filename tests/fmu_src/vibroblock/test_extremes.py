@@ -10,7 +10,8 @@ per halving of dt), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), adaptiv
 its default rtol = 1e-8; the worst case, 3.4e-5, is gamma_n = 1e4: the quadratures ride along
 without error control, and the stiff dashpot's dissipation is where that shows).  On the
 paper's 87 degree corrugation with k_n = 1e8 adaptive stops with its step budget (the
-contact chatter on the steep flank costs > 2^24 steps in t = 100): a clear refusal.
+contact chatter on the steep flank costs > 2^24 steps in t = 100): a clear refusal; so does
+model C bouncing with k_n = 1e8 (as measured; models A and B finish).
 """
 from __future__ import annotations
 
@@ -41,7 +42,8 @@ MATRIX = {
     # (every case below also runs adaptive, at its default tolerances; see ``matrix_cases``)
     "k_n/m = 1e8, at rest": ("A", {"k_n": 1e8}, EXPLICIT_REFUSE),
     "k_n/m = 1e8, at rest, corrugated": ("BC", {"k_n": 1e8}, {**EXPLICIT_REFUSE, "adaptive": BUDGET}),
-    "k_n/m = 1e8, bouncing (A omega^2 = 2 g)": ("ABC", {"k_n": 1e8, "A": 2.0, "omega": 1.0}, EXPLICIT_REFUSE),
+    "k_n/m = 1e8, bouncing (A omega^2 = 2 g)": ("ABC", {"k_n": 1e8, "A": 2.0, "omega": 1.0},
+                                                 {**EXPLICIT_REFUSE, "adaptive": {"C": BUDGET}}),
     "gamma_n = 0": ("ABC", {"gamma_n": 0.0, "A": 0.3, "omega": 1.2}, ALL_RUN),
     "gamma_n = 1e4": ("ABC", {"gamma_n": 1e4, "A": 0.3, "omega": 1.2}, EXPLICIT_REFUSE),
     "gamma_t = 0": ("ABC", {"gamma_t": 0.0, "A": 0.3, "omega": 1.2}, ALL_RUN),
@@ -51,7 +53,7 @@ MATRIX = {
     "omega = 1e3, A omega^2 = 0.1 g": ("ABC", {"A": 1e-7, "omega": 1e3}, ALL_RUN),
     "steep corrugation A_x omega_x = 20 (paper), vibrated": ("BC", {"A": 2.0, "omega": 1.0}, ALL_RUN),
     "steeper corrugation A_x omega_x = 50, stiff contact": ("BC", {"A_x": 2500.0, "k_n": 1e8, "A": 2.0, "omega": 1.0},
-                                                             {**EXPLICIT_REFUSE, "adaptive": BUDGET}),
+                                                             {**EXPLICIT_REFUSE, "adaptive": {"C": BUDGET}}),
     "V_d = 1e-12": ("ABC", {"V_d": 1e-12}, ALL_RUN),
     "V_d = 1e3, flat": ("A", {"V_d": 1e3}, ALL_RUN),
     "V_d = 1e3, corrugated": ("BC", {"V_d": 1e3}, {**ALL_RUN, "implicit_contact": TOO_FAST}),
@@ -69,6 +71,8 @@ def matrix_cases():
     for case, (models, parameters, expected) in MATRIX.items():
         for model in models:
             for integrator, error in {**expected, "adaptive": expected.get("adaptive")}.items():
+                if isinstance(error, dict):  # the outcome differs between the models
+                    error = error.get(model)
                 yield pytest.param(model, integrator, parameters, error, id=f"{case} | {model} | {integrator}")
 
 
