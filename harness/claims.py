@@ -18,8 +18,9 @@ Conventions used by all studies
 * Vibrated runs start on the steady in-contact orbit (``steady_orbit``).  Models B and
   C start at a valley (B) or a crest (C) of the corrugation, at the time when the drive
   spring is relaxed (start_time = x_start / V_d), so that no spring force acts at t0.
-* "Friction" = the block is held by friction in the window: regime stick_slip or stuck
-  (no slip and no sliding within the window); "sliding" = it follows the drive.
+* "Friction" = the block is held by friction in the window: regime stick_slip, stuck
+  (no slip and no sliding within the window) or jammed (self-locked on a flank);
+  "sliding" = it follows the drive; "flying" = no contact in the window (not friction).
 """
 from __future__ import annotations
 
@@ -36,7 +37,7 @@ import numpy as np
 
 from .continuation import Ramp, continuation
 from .fmu import fmu_sha256
-from .observables import SLIDING, STICK_SLIP, observe, window, window_slips
+from .observables import FLYING, SLIDING, STICK_SLIP, observe, window, window_slips
 from .run import simulate
 from .settings import (PRESETS, InitialCondition, ObservableSettings, PointSettings, RunSettings, canonical_json,
                        default_fmu, to_jsonable)
@@ -269,7 +270,8 @@ def ramp_task(item: dict, pool) -> dict:
 
 # ---------------------------------------------------------------------- helpers
 def friction_held(regime: str) -> bool:
-    return regime != SLIDING
+    """Held by friction in the window: stick-slip, stuck or jammed (not sliding, not flying)."""
+    return regime not in (SLIDING, FLYING)
 
 
 def first_sliding(values: Sequence[float], regimes: Sequence[str]) -> float | None:

@@ -16,10 +16,15 @@ Definitions
 * phi = <(vx - V_d)^2> / V_d^2 over the window (the paper's order parameter).  From the
   FMU's exact running integral ``phi_integral`` when recorded, otherwise by the
   trapezoidal rule on the samples.
-* regime: "stick_slip" if phi > threshold; otherwise "sliding" if the block keeps up
-  with the drive (drift velocity >= half of V_d), else "stuck": no slip and no sliding
-  in the window, which is then shorter than a stick phase (phi = 1 for a block at rest,
-  below any sensible threshold): lengthen the window to classify.
+* regime, from what the block does in the window (rules applied in this order):
+  "flying" if it never touches the plate (no contact sample); "stick_slip" if
+  phi > threshold; "sliding" if it keeps up with the drive (drift velocity >= half of
+  V_d); "jammed" if it neither slips nor keeps up while the drive spring's stretch
+  V_d t - x grows and ends beyond the flat surface's Coulomb limit mu_s N0 / k_d (the
+  paper's slip length, N0 = m g or P_l): held by more than friction on a flat plate
+  could hold, i.e. self-locked on a flank (docs/physics.md, "Self-locking"); else
+  "stuck": no slip and no sliding in a window shorter than a stick phase (phi = 1 for
+  a block at rest, below any sensible threshold): lengthen the window to classify.
 * drift velocity: (x(t_to) - x(t_from)) / (t_to - t_from).
 * contact fraction: share of the window's samples with ``contact`` true (sampled at the
   output interval, so it resolves contact phases longer than that interval).
@@ -41,7 +46,8 @@ import xarray as xr
 
 from .settings import ObservableSettings
 
-STICK_SLIP, SLIDING, STUCK = "stick_slip", "sliding", "stuck"
+STICK_SLIP, SLIDING, STUCK, JAMMED, FLYING = "stick_slip", "sliding", "stuck", "jammed", "flying"
+REGIMES = (STICK_SLIP, SLIDING, STUCK, JAMMED, FLYING)
 # A block drifting slower than this share of V_d over a window without slips is stuck.
 STUCK_DRIFT_FRACTION = 0.5
 
@@ -105,6 +111,22 @@ def classify(phi_value: float, threshold: float, drift: float = math.nan, v_d: f
     if abs(drift) < STUCK_DRIFT_FRACTION * abs(v_d):
         return STUCK
     return SLIDING
+
+
+def refine(regime: str, ds: xr.Dataset, win: Window, contact: float) -> str:
+    """The rules that need the trajectory: flying (no contact in the window) and jammed
+    (stuck with the drive spring's stretch growing beyond the flat surface's Coulomb
+    limit); see the module doc."""
+    if contact == 0.0:
+        return FLYING
+    if regime != STUCK:
+        return regime
+    v_d = drive_velocity(ds)
+    time, x = ds["time"].values, ds["x"].values
+    stretch_start = v_d * time[win.first] - x[win.first]
+    stretch_end = v_d * time[win.last] - x[win.last]
+    growing = abs(stretch_end) > abs(stretch_start)
+    return JAMMED if growing and abs(stretch_end) > nominal_slip_length(ds.attrs) else STUCK
 
 
 def drift_velocity(ds: xr.Dataset, win: Window) -> float:
@@ -255,11 +277,13 @@ def observe(ds: xr.Dataset, settings: ObservableSettings = ObservableSettings())
     value = phi(ds, win)
     drift = drift_velocity(ds, win)
     slips = window_slips(ds, win, settings)
+    contact = contact_fraction(ds, win)
+    regime = refine(classify(value, settings.phi_threshold, drift, drive_velocity(ds)), ds, win, contact)
     return Observables(
-        phi=value, regime=classify(value, settings.phi_threshold, drift, drive_velocity(ds)), slip_events=slips.count,
+        phi=value, regime=regime, slip_events=slips.count,
         stick_time_mean=_mean(slips.stick_times), stick_time_std=_std(slips.stick_times),
         slip_interval_mean=_mean(slips.intervals),
         slip_length_mean=_mean(slips.length), slip_length_std=_std(slips.length),
-        contact_fraction=contact_fraction(ds, win), drift_velocity=drift,
+        contact_fraction=contact, drift_velocity=drift,
         coulomb_resets=coulomb_resets(ds, win), window_start=win.start, window_end=win.end,
         transient=settings.transient, phi_threshold=settings.phi_threshold)

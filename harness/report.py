@@ -249,6 +249,8 @@ def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
         row_c = Row("C5c", measured_c, AGREES, "stick-slip without tangential spring")
     elif free["regime"] == "stuck":
         row_c = Row("C5c", measured_c, NOT_REPRODUCED, "no slip in the window (stuck): window shorter than a stick")
+    elif free["regime"] == "jammed":
+        row_c = Row("C5c", measured_c, DISAGREES, "jammed (self-locked on a flank) without tangential spring")
     else:
         row_c = Row("C5c", measured_c, DISAGREES, "sliding without tangential spring")
     return row_a, row_b, row_c

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from harness.observables import (SLIDING, STICK_SLIP, STUCK, classify, contact_fraction, drift_velocity, observe, phi,
+from harness.observables import (FLYING, JAMMED, SLIDING, STICK_SLIP, STUCK, classify, contact_fraction, drift_velocity, observe, phi,
                                  slip_events, window)
 from harness.settings import ObservableSettings
 
@@ -138,10 +138,25 @@ def test_contact_fraction_drift_and_classification():
     assert classify(1.0, 10.0, 0.01 * V_D, V_D) == STUCK
 
 
-def test_a_window_without_slips_and_without_drift_is_stuck():
+def test_a_window_without_slips_and_without_drift_is_stuck_or_jammed_by_the_spring_stretch():
+    # The drive spring's stretch reaches 0.97 V_d 3000 = 29.1 at the end of the window:
+    # jammed when that is beyond mu_s m g / k_d (the flat plate's slip length), stuck below.
     t = np.arange(0.0, 3000.0, 1.0)
-    result = observe(dataset(t, np.full_like(t, 0.03 * V_D)), ObservableSettings(transient=100.0))
-    assert result.phi == pytest.approx(0.97**2) and result.regime == STUCK and not result.stick_slip
+    creeping = np.full_like(t, 0.03 * V_D)
+    settings = ObservableSettings(transient=100.0)
+    short_stick = observe(dataset(t, creeping, k_d=0.5 / 20.0), settings)   # slip length 20 < 29.1
+    long_stick = observe(dataset(t, creeping, k_d=0.5 / 40.0), settings)    # slip length 40 > 29.1
+    assert short_stick.phi == pytest.approx(0.97**2) and short_stick.regime == JAMMED
+    assert long_stick.regime == STUCK and not long_stick.stick_slip
+    # Confined by P_l (model C) instead of m g: the same rule with N0 = P_l.
+    assert observe(dataset(t, creeping, k_d=0.5 / 20.0, P_l=2.0), settings).regime == STUCK
+
+
+def test_a_block_that_never_touches_the_plate_is_flying_whatever_its_phi():
+    t, vx, _ = stick_slip_signal()
+    in_contact = observe(dataset(t, vx, contact=np.ones_like(t, dtype=bool)), ObservableSettings(transient=0.0))
+    airborne = observe(dataset(t, vx, contact=np.zeros_like(t, dtype=bool)), ObservableSettings(transient=0.0))
+    assert in_contact.regime == STICK_SLIP and airborne.regime == FLYING
 
 
 def test_a_window_without_two_samples_is_refused():
