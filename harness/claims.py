@@ -42,7 +42,7 @@ from .run import simulate
 from .settings import (PRESETS, InitialCondition, ObservableSettings, PointSettings, RunSettings, canonical_json,
                        default_fmu, to_jsonable)
 from .store import write_json_atomically
-from .sweep import Axis, Execution, Grid, map_with_pool, run_sweep
+from .sweep import OBSERVABLES_VERSION, Axis, Execution, Grid, map_with_pool, run_sweep
 
 SCALED = dict(PRESETS["scaled"])
 OMEGA_X = 2e-2
@@ -161,7 +161,7 @@ class Runner:
         keys = []
         for item in items:
             text = canonical_json({"function": f"{function.__module__}.{function.__qualname__}", "item": item,
-                                   "fmu_sha256": self._sha})
+                                   "fmu_sha256": self._sha, "observables_version": OBSERVABLES_VERSION})
             keys.append(hashlib.sha256(text.encode()).hexdigest())
         results: dict[int, dict] = {}
         for number, key in enumerate(keys):

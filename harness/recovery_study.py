@@ -43,8 +43,9 @@ from .sweep import Axis, Grid
 RECOVERY_RESOLUTION = 0.03  # relative width of a located transition in omega
 K_N, GAMMA_N, LOAD = 1.0, 0.07, 1.0  # the paper's contact (delta_0 = load / k_n = 1)
 # Stick time of the scaled drive ~ mu_s m g / (k_t V_S) ~ 5200: the window holds >= 3 cycles.
-OBSERVE = ObservableSettings(transient=4000.0)
-HORIZON = 20_000.0
+# Model C starts on a crest with the spring relaxed: the first wavelength (lambda / V_d =
+# 3.1e4) is a transient (the descent into the valley and the climb of the next flank, where
+# a held block self-locks), so its window is the last 2e4 of 6e4.
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,12 @@ class Configuration:
     model: str
     readings: tuple  # (name, value) pairs of FMU Integer parameters
     integrator: str = "symplectic_euler"
+    horizon: float = 20_000.0
+    transient: float = 4_000.0
+
+    @property
+    def observe(self) -> ObservableSettings:
+        return ObservableSettings(transient=self.transient)
 
     def parameters(self, **values) -> dict:
         return {**SCALED, **dict(self.readings), **values}
@@ -64,8 +71,8 @@ CONFIGURATIONS = (
     # event_driven is exact for model A and refuses the applied-load bound.
     Configuration("A, contact-force bound", "A", (("coulomb_normal", 0),), integrator="event_driven"),
     Configuration("A, applied-load bound", "A", (("coulomb_normal", 1),)),
-    Configuration("C, fixed axes", "C", (("formulation", 0),)),
-    Configuration("C, tangent frame", "C", (("formulation", 1),)),
+    Configuration("C, fixed axes", "C", (("formulation", 0),), horizon=60_000.0, transient=40_000.0),
+    Configuration("C, tangent frame", "C", (("formulation", 1),), horizon=60_000.0, transient=40_000.0),
 )
 
 
@@ -73,19 +80,24 @@ CONFIGURATIONS = (
 class Sizes:
     amplitudes: tuple        # A / delta_0, model A
     amplitudes_c: tuple      # A / delta_0, model C (each point costs ~100x a model A point)
-    omegas: tuple            # the grid kept for the figure
+    omegas: tuple            # the grid kept for the figure (model A)
+    omegas_c: tuple          # the same for model C
     ramp_points: int         # steps of the hysteresis ramp (each way)
     stiffnesses: tuple       # k_n for C6d, at k_n / gamma_n fixed
     configurations: tuple    # labels run
 
 
 SIZES = {
-    "default": Sizes(amplitudes=(0.3, 0.6), amplitudes_c=(0.3,), omegas=tuple(np.round(np.geomspace(0.3, 60.0, 12), 4)), ramp_points=7,
+    # Grids denser around the contact resonance omega_n = sqrt(k_n/m) = 1, where the
+    # amplitudes below delta_0 can lose friction (a band of width ~1.35 at A = 0.3 delta_0).
+    "default": Sizes(amplitudes=(0.3, 0.6), amplitudes_c=(0.3,),
+                     omegas=tuple(np.round(np.concatenate([np.geomspace(0.3, 3.0, 13), np.geomspace(3.0, 60.0, 7)[1:]]), 4)),
+                     omegas_c=(0.3, 0.6, 0.85, 1.0, 1.15, 1.4, 2.5, 6.0, 15.0, 40.0), ramp_points=5,
                      stiffnesses=(0.5, 1.0, 2.0), configurations=tuple(c.label for c in CONFIGURATIONS)),
-    "quick": Sizes(amplitudes=(0.3,), amplitudes_c=(0.3,), omegas=tuple(np.round(np.geomspace(0.3, 60.0, 7), 4)), ramp_points=4,
-                   stiffnesses=(0.5, 2.0), configurations=("A, contact-force bound", "C, tangent frame")),
-    "tiny": Sizes(amplitudes=(0.3,), amplitudes_c=(0.3,), omegas=(0.5, 1.1, 2.5), ramp_points=3, stiffnesses=(1.0,),
-                  configurations=("A, contact-force bound",)),
+    "quick": Sizes(amplitudes=(0.3,), amplitudes_c=(), omegas=(0.5, 0.8, 1.0, 1.25, 1.6, 3.0, 10.0, 30.0, 60.0),
+                   omegas_c=(), ramp_points=4, stiffnesses=(0.5, 2.0), configurations=("A, contact-force bound",)),
+    "tiny": Sizes(amplitudes=(0.3,), amplitudes_c=(), omegas=(0.5, 1.1, 2.5), omegas_c=(), ramp_points=3,
+                  stiffnesses=(1.0,), configurations=("A, contact-force bound",)),
 }
 
 
@@ -118,24 +130,21 @@ def _run(runner: Runner, configuration: Configuration, amplitude: float, **value
     parameters = configuration.parameters(A=amplitude, **values)
     integration = Integration(configuration.integrator)
     if configuration.model == "A":
-        return runner.run("A", parameters=parameters, horizon=HORIZON, integration=integration)
-    return runner.run("C", parameters=parameters, horizon=HORIZON, integration=integration,
+        return runner.run("A", parameters=parameters, horizon=configuration.horizon, integration=integration)
+    return runner.run("C", parameters=parameters, horizon=configuration.horizon, integration=integration,
                       initial=InitialCondition("steady_orbit", x_start=CREST),
                       start_time=_relaxed_start(CREST, parameters["V_d"]))
 
 
-def _point(run, omega: float) -> PointSettings:
-    return PointSettings(run=run.with_parameters({"omega": float(omega)}), observe=OBSERVE)
+def _held_along_omega(runner: Runner, base: PointSettings, omegas) -> list[bool]:
+    items = [{"point": PointSettings(run=base.run.with_parameters({"omega": float(w)}), observe=base.observe)}
+             for w in omegas]
+    return [friction_held(r["observables"]["regime"]) for r in runner.tasks(run_and_measure, items)]
 
 
-def _held_along_omega(runner: Runner, run, omegas) -> list[bool]:
-    results = runner.tasks(run_and_measure, [{"point": _point(run, w)} for w in omegas])
-    return [friction_held(r["observables"]["regime"]) for r in results]
-
-
-def _transitions(runner: Runner, run, omegas, regimes) -> list[dict]:
+def _transitions(runner: Runner, base: PointSettings, omegas, regimes) -> list[dict]:
     held = [friction_held(r) for r in regimes]
-    found = locate_transitions(lambda points: _held_along_omega(runner, run, points), omegas, held,
+    found = locate_transitions(lambda points: _held_along_omega(runner, base, points), omegas, held,
                                resolution=RECOVERY_RESOLUTION)
     return [t.as_dict() for t in found]
 
@@ -146,18 +155,21 @@ def _closest(value: float, candidates: list[float]) -> float | None:
 
 def _row(runner: Runner, configuration: Configuration, amplitude: float, omegas, k_n: float = K_N) -> dict:
     gamma_n = k_n / (K_N / GAMMA_N)
-    run = _run(runner, configuration, amplitude, k_n=k_n, gamma_n=gamma_n)
-    ds = runner.sweep(Grid((Axis("omega", omegas),)), PointSettings(run=run, observe=OBSERVE))
+    base = PointSettings(run=_run(runner, configuration, amplitude, k_n=k_n, gamma_n=gamma_n),
+                         observe=configuration.observe)
+    ds = runner.sweep(Grid((Axis("omega", omegas),)), base)
     regimes = ds.regime.values.tolist()
-    transitions = _transitions(runner, run, list(omegas), regimes)
+    transitions = _transitions(runner, base, list(omegas), regimes)
     candidates = predictions(amplitude, k_n=k_n, gamma_n=gamma_n, load=LOAD)
-    recoveries = [t for t in transitions if t["kind"] == RECOVERY]
     losses = [t for t in transitions if t["kind"] == LOSS]
+    omega_1 = losses[0]["value"] if losses else None
+    # omega_2: friction regained above the first loss.
+    recoveries = [t for t in transitions if t["kind"] == RECOVERY and omega_1 is not None and t["value"] > omega_1]
     omega_2 = recoveries[0]["value"] if recoveries else None
     return {"configuration": configuration.label, "A": amplitude, "k_n": k_n, "gamma_n": gamma_n,
             "omegas": list(omegas), "regimes": regimes,
             "contact_fraction": ds.contact_fraction.values.tolist(), "phi": ds.phi.values.tolist(),
-            "transitions": transitions, "omega_1": losses[0]["value"] if losses else None, "omega_2": omega_2,
+            "transitions": transitions, "omega_1": omega_1, "omega_2": omega_2,
             "omega_2_resolution": recoveries[0]["resolution"] if recoveries else None,
             "loss_above_omega_2": next((t["value"] for t in losses if omega_2 and t["value"] > omega_2), None),
             **candidates}
@@ -167,7 +179,8 @@ def _hysteresis(runner: Runner, configuration: Configuration, amplitude: float, 
     """Ramp omega up then down across omega_2 on one live instance; where friction returns each way."""
     values = tuple(float(v) for v in np.geomspace(omega_2 / 1.6, omega_2 * 1.6, points))
     run = _run(runner, configuration, amplitude, omega=values[0])
-    [loop] = runner.tasks(ramp_task, [{"point": PointSettings(run=run, observe=OBSERVE), "ramp": Ramp("omega", values)}])
+    point = PointSettings(run=run, observe=configuration.observe)
+    [loop] = runner.tasks(ramp_task, [{"point": point, "ramp": Ramp("omega", values)}])
     up = [(v, r) for d, v, r in zip(loop["direction"], loop["value"], loop["regime"]) if d == "up"]
     down = [(v, r) for d, v, r in zip(loop["direction"], loop["value"], loop["regime"]) if d == "down"]
     up_held = [v for v, r in up if friction_held(r)]
@@ -186,15 +199,17 @@ def _hysteresis(runner: Runner, configuration: Configuration, amplitude: float, 
 def study_recovery(runner: Runner) -> Study:
     sizes = SIZES[runner.resolution.name]
     configurations = [c for c in CONFIGURATIONS if c.label in sizes.configurations]
-    rows = [_row(runner, c, a * LOAD / K_N, sizes.omegas) for c in configurations
-            for a in (sizes.amplitudes if c.model == "A" else sizes.amplitudes_c)]
+    rows = [_row(runner, c, a * LOAD / K_N, sizes.omegas if c.model == "A" else sizes.omegas_c)
+            for c in configurations for a in (sizes.amplitudes if c.model == "A" else sizes.amplitudes_c)]
     loops = []
     for configuration in configurations:
         first = next((r for r in rows if r["configuration"] == configuration.label and r["omega_2"]), None)
         if first is not None:
             loops.append(_hysteresis(runner, configuration, first["A"], first["omega_2"], sizes.ramp_points))
-    # C6d: k_n changes at fixed k_n / gamma_n; A = a delta_0 with delta_0 = P_l / k_n.
-    stiff_configuration = next(c for c in CONFIGURATIONS if c.label == sizes.configurations[-1])
+    # C6d: k_n changes at fixed k_n / gamma_n; A = a delta_0 with delta_0 = P_l / k_n.  On
+    # model A (exact and cheap): model C's normal motion in the tangent frame is model A's
+    # oscillator with P_l in place of m g, and in model C every held block self-locks.
+    stiff_configuration = CONFIGURATIONS[0]
     scaled_amplitude = sizes.amplitudes[0]
     stiffness_rows = [_row(runner, stiff_configuration, scaled_amplitude * LOAD / k_n, sizes.omegas, k_n=k_n)
                       for k_n in sizes.stiffnesses]
@@ -208,13 +223,16 @@ def study_recovery(runner: Runner) -> Study:
     settings = {"models": ", ".join(c.label for c in configurations),
                 "parameters": "scaled drive (k_d = V_d = 1e-2, gamma_t = 5e-3), k_n = 1, gamma_n = 0.07, P_l = m g = 1; "
                               "C on the paper's plate",
-                "amplitudes": "A / delta_0 = " + ", ".join(f"{a:g}" for a in sizes.amplitudes),
-                "horizon": HORIZON, "initial": "A: steady orbit; C: crest, steady orbit, spring relaxed at t0",
-                "bisection": f"to {RECOVERY_RESOLUTION:.0%} in omega", **_observe_json(OBSERVE)}
+                "amplitudes": "A / delta_0 = " + ", ".join(f"{a:g}" for a in sizes.amplitudes) + " (model A), "
+                              + (", ".join(f"{a:g}" for a in sizes.amplitudes_c) or "none") + " (model C)",
+                "horizon": "A: 2e4 (transient 4e3); C: 6e4 (transient 4e4)",
+                "integrators": "; ".join(f"{c.label}: {c.integrator}" for c in configurations),
+                "initial": "A: steady orbit; C: crest, steady orbit, spring relaxed at t0",
+                "bisection": f"to {RECOVERY_RESOLUTION:.0%} in omega", **_observe_json(CONFIGURATIONS[0].observe)}
     return Study("C6r", measured, settings, {"rows": rows + stiffness_rows, "loops": loops})
 
 
-__all__ = ["CONFIGURATIONS", "RECOVERY_RESOLUTION", "crossings", "predictions", "study_recovery"]
+
 
 
 # ---------------------------------------------------------------------- verdicts
@@ -313,3 +331,51 @@ CLAIM_TEXT = {
     "C6r-c": "C: no hysteresis at omega_2 (continuation up and down across it)",
     "C6r-d": "C: omega_2 weakly dependent on k_n at fixed k_n/gamma_n, A scaled by delta_0",
 }
+
+
+# ---------------------------------------------------------------------- figure
+FIGURE = "fig_recovery.png"
+
+
+def draw(study: Study, path) -> None:
+    """One panel per configuration: regimes on the omega grid at each A (in delta_0), the
+    located transitions (bars: the bisection bracket), A_c(omega) and A_N(omega), k_n/gamma_n."""
+    import matplotlib.pyplot as plt
+
+    from .plots import REGIME_STYLE
+
+    rows = [r for r in study.measured["rows"]] + [
+        {**r, "configuration": f"{r['configuration']}, k_n = {r['k_n']:g} (A in P_l/k_n)"}
+        for r in study.measured["stiffness_rows"] if r["k_n"] != K_N]
+    labels = list(dict.fromkeys(r["configuration"] for r in rows))
+    fig, axes = plt.subplots(len(labels), 1, figsize=(7.0, 2.6 * len(labels)), squeeze=False)
+    for ax, label in zip(axes[:, 0], labels):
+        group = [r for r in rows if r["configuration"] == label]
+        k_n, gamma_n = group[0]["k_n"], group[0]["gamma_n"]
+        delta_0 = LOAD / k_n
+        line = np.geomspace(min(group[0]["omegas"]) / 1.5, max(group[0]["omegas"]) * 1.5, 400)
+        ax.plot(line, detachment_amplitude(line, 1.0, LOAD, k_n, gamma_n) / delta_0, "k-", lw=1, label="$A_c(\\omega)$")
+        ax.plot(line, friction_loss_amplitude(line, 1.0, LOAD, k_n, gamma_n) / delta_0, "k--", lw=1,
+                label="$A_N(\\omega)$")
+        ax.axvline(k_n / gamma_n, color="tab:orange", lw=1, label="$k_n/\\gamma_n$")
+        shown = set()
+        for r in group:
+            level = r["A"] / delta_0
+            for omega, regime in zip(r["omegas"], r["regimes"]):
+                style = REGIME_STYLE.get(regime, {"marker": "?", "color": "k", "label": regime})
+                ax.scatter([omega], [level], marker=style["marker"], color=style["color"],
+                           label=None if regime in shown else style["label"])
+                shown.add(regime)
+            for t in r["transitions"]:
+                color = "tab:red" if t["kind"] == LOSS else "tab:blue"
+                ax.plot([t["value"]], [level * 1.5], marker="v", color=color, ms=7)
+                ax.annotate(f"{t['value']:.3g}", (t["value"], level * 1.75), ha="center", fontsize=7, color=color)
+        ax.set(xscale="log", yscale="log", ylim=(0.05, 3.0), xlabel="$\\omega$", ylabel="$A/\\delta_0$", title=label)
+        ax.legend(fontsize=6, ncol=3, loc="lower left")
+    fig.suptitle("Friction lost (red triangles) and regained (blue) as located by bisection; scaled drive", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+__all__ = ["CLAIM_TEXT", "CONFIGURATIONS", "FIGURE", "RECOVERY_RESOLUTION", "crossings", "draw", "predictions",
+           "study_recovery", "verdict_rows"]
