@@ -1,7 +1,7 @@
 """The readings of models B and C (``vibroblock.readings``, docs/physics.md): formulation,
 Coulomb bound and flight, checked against facts -- the reduction to model A, statics,
 Eq. (9)'s stick positions, the detachment onset, the energy balance, save/restore -- and
-against the independent reference (``harness.reference``)."""
+against the independent reference (``harness.paper.reference``)."""
 import math
 
 import numpy as np
