@@ -18,7 +18,7 @@ from pathlib import Path
 
 from harness.paper.claims import RESOLUTIONS, Runner, run_studies, save_studies
 from harness.cosim.fmu import REPO_ROOT
-from harness.paper.report import write_report
+from harness.paper.report import timing_lines, write_report
 from harness.runs.sweep import INLINE, Execution, close_client, open_client
 
 def main(argv: list[str] | None = None) -> Path:
@@ -60,6 +60,8 @@ def main(argv: list[str] | None = None) -> Path:
               f"{runner.points_computed} / {runner.points_reused}", "wall time": f"{elapsed:.0f} s",
               "measured values": "claims.json"}
     path = write_report(studies, out, (), header)
+    for line in timing_lines(studies):
+        print(line)
     print(f"report: {path}  ({elapsed:.0f} s, resolution {resolution.name})")
     return path
 

@@ -65,6 +65,12 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
     for name, study in studies.items():
         lines.append(f"| {name} | {_cell(_settings_text(study.settings))}; merge gap {study.settings.get('merge_gap', 'n/a')}, "
                      f"min slip fraction {study.settings.get('slip_min_fraction', 'n/a')} |")
+    timed = {name: study.timing for name, study in studies.items() if study.timing}
+    if timed:
+        lines += ["", "## Time per study", "", "| study | wall time | from | points computed / from the store | "
+                  "runs and ramps computed / from the store |", "|---|---|---|---|---|"]
+        lines += [f"| {name} | {t['wall_time']:.1f} s | {t['source']} | {t['points_computed']} / {t['points_reused']} "
+                  f"| {t['tasks_computed']} / {t['tasks_reused']} |" for name, t in timed.items()]
     if figures_present:
         lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures_present]
     return "\n".join(lines) + "\n"
@@ -93,6 +99,13 @@ def make_figures(studies: dict[str, Study], out: str | os.PathLike) -> list[str]
     return written
 
 
+def timing_lines(studies: dict[str, Study]) -> list[str]:
+    """One line per study: its wall time and where its results came from (for the main job's output)."""
+    return [f"{name}: {s.timing['wall_time']:.1f} s ({s.timing['source']}; points {s.timing['points_computed']} "
+            f"computed / {s.timing['points_reused']} from the store, runs and ramps {s.timing['tasks_computed']} / "
+            f"{s.timing['tasks_reused']})" for name, s in studies.items() if s.timing]
+
+
 def write_report(studies: dict[str, Study], out: str | os.PathLike, extra_figures: Sequence[str] = (),
                  header: dict | None = None) -> Path:
     """Figures and ``<out>/report.md`` from the studies; the report's path."""
@@ -104,4 +117,4 @@ def write_report(studies: dict[str, Study], out: str | os.PathLike, extra_figure
 
 
 __all__ = ["AGREES", "CLAIM_TEXT", "DISAGREES", "FIGURES", "NOT_REPRODUCED", "Row", "claim_rows", "make_figures",
-           "markdown", "write_report"]
+           "markdown", "timing_lines", "write_report"]

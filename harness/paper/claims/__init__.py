@@ -12,12 +12,13 @@ worker tasks, regime arithmetic), :mod:`.verdicts` (verdict words, Row, toleranc
 """
 from __future__ import annotations
 
+import time
 from typing import Sequence
 
 from . import (c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery, c7_contact,
                c8_drive_velocity, fig1b)
 from .measure import friction_held, onset_amplitude, recovery, stable_roots_near, transition_bracket
-from .study import RESOLUTIONS, Claim, Resolution, Runner, Study, load_studies, save_studies
+from .study import RESOLUTIONS, Claim, Resolution, Runner, Study, counts, load_studies, save_studies, timing
 
 CLAIMS: dict[str, Claim] = {module.CLAIM.name: module.CLAIM for module in (
     fig1b, c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery, c7_contact,
@@ -26,7 +27,7 @@ STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 
 
 def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: bool = True) -> dict[str, Study]:
-    """Run the named studies in order; {claim: Study}."""
+    """Run the named studies in order; {claim: Study}, each with its timing."""
     results = {}
     bar = None
     if progress:
@@ -37,7 +38,9 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
         for name in names:
             if bar is not None:
                 bar.set_postfix_str(name)
+            before, started = counts(runner), time.perf_counter()
             results[name] = CLAIMS[name].study(runner)
+            results[name].timing = timing(time.perf_counter() - started, before, counts(runner))
             if bar is not None:
                 bar.update(1)
     finally:

@@ -92,12 +92,14 @@ class Study:
 
     ``measured``: the numbers the verdict is computed from (JSON-able);
     ``settings``: parameter set, start, threshold, window, transient per part;
-    ``data``: arrays for the figures (JSON-able lists)."""
+    ``data``: arrays for the figures (JSON-able lists);
+    ``timing``: wall time of the study and what of it came from the store (:func:`timing`)."""
 
     claim: str
     measured: dict
     settings: dict
     data: dict = field(default_factory=dict)
+    timing: dict = field(default_factory=dict)
 
 
 class Runner:
@@ -113,6 +115,8 @@ class Runner:
         self._sha = {m: fmu_sha256(path) for m, path in self.fmus.items()}
         self.points_computed = 0
         self.points_reused = 0
+        self.tasks_computed = 0
+        self.tasks_reused = 0
 
     def run(self, model: str, **fields) -> RunSettings:
         return RunSettings(fmu=self.fmus[model], **fields)
@@ -137,6 +141,8 @@ class Runner:
             if path.exists():
                 results[number] = json.loads(path.read_text())["result"]
         missing = [n for n in range(len(items)) if n not in results]
+        self.tasks_computed += len(missing)
+        self.tasks_reused += len(items) - len(missing)
         if missing:
             computed = map_with_pool(function, [items[n] for n in missing], self.execution, self.client)
             for number, result in zip(missing, computed):
@@ -144,6 +150,22 @@ class Runner:
                                                                         "result": result})
                 results[number] = result
         return [results[n] for n in range(len(items))]
+
+
+def counts(runner: Runner) -> dict:
+    """What the runner has computed and reused from its store so far."""
+    return {"points_computed": runner.points_computed, "points_reused": runner.points_reused,
+            "tasks_computed": runner.tasks_computed, "tasks_reused": runner.tasks_reused}
+
+
+def timing(wall_time: float, before: dict, after: dict) -> dict:
+    """A study's wall time and its points and tasks computed or read from the store, from the
+    runner's :func:`counts` before and after it; ``source`` says where its results came from."""
+    spent = {key: after[key] - before[key] for key in after}
+    computed = spent["points_computed"] + spent["tasks_computed"]
+    reused = spent["points_reused"] + spent["tasks_reused"]
+    source = "store" if reused and not computed else "computed" if not reused else "partly from the store"
+    return {"wall_time": wall_time, "source": source, **spent}
 
 
 @dataclass(frozen=True)
