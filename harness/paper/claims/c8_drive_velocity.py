@@ -1,8 +1,12 @@
 """C8 -- models A and C: V_d-omega diagrams; the stationary sliding offset x0 of model A.
 
 Criteria: C8a: at the largest V_d every omega slides, in models A and C.  C8b: the
-measured x0 within ``FORMULA_TOLERANCE`` of the paper's printed
-x0 = (gamma_t V_d - mu_s m g/2)/k_d."""
+measured x0 (mean lag V_d t - x of model A sliding without vibration) within
+``FORMULA_TOLERANCE`` of the paper's printed x0 = (gamma_t V_d - mu_s m g/2)/k_d.  When it
+is not, and x0 is within the tolerance of the force balance of stationary sliding,
+x0 = (gamma_t V_d + mu_s m g/2)/k_d (dashpot plus dynamic friction mu_s m g/2 against the
+drive spring), the report calls the printed minus a sign typo and gives the measured
+agreement with the corrected formula."""
 from __future__ import annotations
 
 import numpy as np
@@ -78,13 +82,25 @@ def verdict_c8(m: dict) -> tuple[Row, Row]:
     row_a = Row("C8a", " | ".join(texts) + f" (A: A = {m['model_a_amplitude']:g}; C: A = {m['model_c_amplitude']:g})",
                 verdict, reason)
     offsets = m["offsets"]
-    measured = "; ".join(f"V_d = {o['V_d']:g}: x0 = {fmt(o['x0'], 4)} +- {fmt(o['x0_std'], 2)}, force balance "
-                         f"{fmt(o['force_balance'], 4)}, paper {fmt(o['paper'], 4)}" for o in offsets)
+    measured = "; ".join(f"V_d = {o['V_d']:g}: x0 = {fmt(o['x0'], 4)} +- {fmt(o['x0_std'], 2)}, corrected formula "
+                         f"{fmt(o['force_balance'], 4)}, printed {fmt(o['paper'], 4)}" for o in offsets)
     against_paper = max(relative(o["x0"], o["paper"]) for o in offsets)
     against_balance = max(relative(o["x0"], o["force_balance"]) for o in offsets)
-    verdict = AGREES if against_paper <= FORMULA_TOLERANCE else DISAGREES
-    reason = (f"largest deviation from the paper's x0 {against_paper:.0%}, from (gamma_t V_d + mu_s mg/2)/k_d "
-              f"{against_balance:.1%}: the sign of mu_s mg/(2 k_d) is +, not -")
+    worst = max(offsets, key=lambda o: relative(o["x0"], o["force_balance"]))
+    precision = (f"the corrected x0 = (gamma_t V_d + mu_s mg/2)/k_d agrees to {fmt(against_balance, 2)} relative "
+                 f"(largest at V_d = {worst['V_d']:g}: |x0 - formula| = {fmt(abs(worst['x0'] - worst['force_balance']), 2)}"
+                 f", x0 fluctuating by +- {fmt(worst['x0_std'], 2)} in the window)")
+    if against_paper <= FORMULA_TOLERANCE:
+        verdict, reason = AGREES, f"x0 within {FORMULA_TOLERANCE:.0%} of the printed formula ({against_paper:.1%})"
+    elif against_balance <= FORMULA_TOLERANCE:
+        # The printed formula fails and the force balance of stationary sliding holds: a sign typo.
+        verdict = DISAGREES
+        reason = (f"the paper's printed x0 = (gamma_t V_d - mu_s mg/2)/k_d has a sign typo (measured x0 off it by up "
+                  f"to {against_paper:.0%}); {precision}")
+    else:
+        verdict = DISAGREES
+        reason = (f"x0 matches neither the printed formula (off by up to {against_paper:.0%}) nor the corrected "
+                  f"one (off by up to {against_balance:.0%})")
     return row_a, Row("C8b", measured, verdict, reason)
 
 
