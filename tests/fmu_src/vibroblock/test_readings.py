@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from harness import analytic, reference
+from harness.paper import analytic, reference
 from vibroblock import Block, ModelError
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from harness import analytic, reference
+from harness.paper import analytic, reference
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 GENTLE = {"A_x": 1.0, "omega_x": 0.5}  # slopes up to 0.5 (27 degrees): no self-locking for mu_s = 0.5

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from harness import cli
+from harness.runs import cli
 from harness.runs.dataset_files import load_dataset
 
 

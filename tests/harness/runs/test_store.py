@@ -16,7 +16,7 @@ import psutil
 import pytest
 import xarray as xr
 
-from harness import cli
+from harness.runs import cli
 from harness.runs.settings import Integration, ObservableSettings, PointSettings, RunSettings
 from harness.runs.store import PointStore, StoreMismatch
 from harness.runs.sweep import INLINE, Execution, Grid, run_sweep
