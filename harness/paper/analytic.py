@@ -99,3 +99,31 @@ def self_locking(alpha: float, mu_s: float) -> bool:
     """A drive pulling the block up a flank of angle alpha presses it in as hard as it pulls
     it along: it never slips once tan(alpha) >= 1 / mu_s."""
     return math.tan(alpha) >= 1.0 / mu_s
+
+
+def restitution(k_n=1.0, gamma_n=0.07, m=1.0):
+    """The contact's coefficient of restitution e: a block meeting the plate at normal
+    speed v leaves it at e v.  In contact it is the damped oscillator m y'' + gamma_n y' +
+    k_n y = 0 (N may pull, so contact ends when the penetration returns to 0, after half
+    a damped period): e = exp(-pi zeta / sqrt(1 - zeta^2)), zeta = gamma_n / (2 sqrt(k_n m)).
+    Gravity is left out (exact for g = 0; for g > 0 valid when m g << k_n times the largest
+    penetration)."""
+    zeta = np.asarray(gamma_n, dtype=float) / (2.0 * np.sqrt(k_n * m))
+    if np.any(zeta >= 1.0):
+        raise ValueError("the contact is overdamped (zeta >= 1): the block does not rebound")
+    return np.exp(-math.pi * zeta / np.sqrt(1.0 - zeta ** 2))
+
+
+def bouncing_floor(e):
+    """Gamma* = A omega^2 / g below which a bouncing ball with restitution e on a plate
+    vibrating as A sin(omega t) cannot keep bouncing: Gamma* = pi (1 - e) / (1 + e) (the
+    period-one orbit's existence bound: the plate must return the energy an impact loses)."""
+    e = np.asarray(e, dtype=float)
+    return math.pi * (1.0 - e) / (1.0 + e)
+
+
+def bouncing_floor_omega(amplitude, load=1.0, m=1.0, k_n=1.0, gamma_n=0.07):
+    """omega* = sqrt(Gamma* g / A), g = load / m: the lowest frequency at which a plate of
+    amplitude A keeps the block bouncing (the bouncing branch ends below it)."""
+    g = load / m
+    return np.sqrt(bouncing_floor(restitution(k_n, gamma_n, m)) * g / np.asarray(amplitude, dtype=float))

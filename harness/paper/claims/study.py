@@ -39,7 +39,7 @@ class Resolution:
     c3_omegas: tuple
     c3_amplitudes: tuple
     c4_gammas: tuple
-    c4_omegas: tuple
+    c4_omegas: tuple           # down to below the bouncing-ball floor of the two smallest gamma_n
     c4_step: float             # duration of a ramp step
     b_horizon: float           # model B x(t) runs
     b_amplitudes: tuple
@@ -62,7 +62,7 @@ RESOLUTIONS = {
         name="default", horizon_a=20_000.0, c2_amplitudes=(0.0, 4.0, 8.0, 12.0, 15.0),
         c3_omegas=tuple(np.round(np.geomspace(0.1, 4.0, 9), 4)),
         c3_amplitudes=tuple(np.round(np.geomspace(0.02, 300.0, 10), 4)),
-        c4_gammas=(0.035, 0.07, 0.14, 0.28), c4_omegas=tuple(np.round(np.arange(0.15, 0.5001, 0.025), 4)),
+        c4_gammas=(0.035, 0.07, 0.14, 0.28), c4_omegas=tuple(np.round(np.arange(0.075, 0.5001, 0.025), 4)),
         c4_step=12_000.0, b_horizon=100_000.0, b_amplitudes=(0.0, 1.0, 2.5, 5.0, 10.0), c_horizon=10_000.0,
         c6_amplitudes=(0.1, 0.3, 1.0, 3.0, 10.0, 30.0), c6_omegas=tuple(np.round(np.geomspace(0.1, 50.0, 10), 4)),
         c6_ratios=(7.0, 14.29, 28.57), c6_stiffnesses=(0.5, 1.0, 2.0),
@@ -72,7 +72,7 @@ RESOLUTIONS = {
     "quick": Resolution(
         name="quick", horizon_a=14_000.0, c2_amplitudes=(0.0, 8.0, 15.0), c3_omegas=(0.1, 0.3, 1.0, 3.0),
         c3_amplitudes=(0.03, 0.3, 3.0, 30.0, 300.0), c4_gammas=(0.035, 0.07, 0.28),
-        c4_omegas=(0.2, 0.3, 0.4, 0.5), c4_step=8_000.0, b_horizon=40_000.0, b_amplitudes=(0.0, 5.0),
+        c4_omegas=(0.08, 0.12, 0.2, 0.3, 0.4, 0.5), c4_step=8_000.0, b_horizon=40_000.0, b_amplitudes=(0.0, 5.0),
         c_horizon=5_000.0, c6_amplitudes=(0.3, 3.0), c6_omegas=(0.1, 1.0, 5.0, 14.0, 40.0),
         c6_ratios=(7.0, 14.29), c6_stiffnesses=(1.0, 2.0), c6_relative_omegas=(0.5, 2.0),
         c6_ramp=(5.0, 14.0, 40.0), c6_ramp_step=4_000.0, c7_omegas=(0.1, 1.0, 14.0, 40.0),
