@@ -5,7 +5,7 @@
 A harmonic plate motion (A = 0.4, omega = 0.5: A omega^2 = 0.1 g) drives model A
 (scaled stick-slip set) four ways: the block's own drive (reference), fmpy's input
 table, the Excitation FMU connected to the block in an SSP file run by fmpy, and the
-same file run by libcosim (harness/compose.py).  For each communication step the
+same file run by libcosim (harness/ground/compose.py).  For each communication step the
 script prints the errors against the reference sampled at the same step and saves
 out/communication_step.md and out/communication_step.png.  The default set takes
 about two minutes.
@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def run_experiment(steps=None, horizon=None, out_dir=ROOT / "out", fmu_dir=ROOT / "build" / "fmus",
                    show_plot=False):
-    from harness.compose import StudySettings, communication_step_study, markdown_table
+    from harness.ground.compose import StudySettings, communication_step_study, markdown_table
 
     settings = StudySettings(block_fmu=str(Path(fmu_dir) / "BlockA.fmu"),
                              excitation_fmu=str(Path(fmu_dir) / "Excitation.fmu"))

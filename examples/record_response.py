@@ -6,7 +6,7 @@
 The record (any format obspy reads, with the instrument response removed through
 ``--inventory``; PEER ``.AT2``; or two-column time/value text with ``--quantity`` and
 ``--unit``) is processed to consistent ground acceleration, velocity and displacement
-(harness.records), optionally rescaled to a peak acceleration of ``--peak-g`` times the
+(harness.ground.records), optionally rescaled to a peak acceleration of ``--peak-g`` times the
 block's gravity, and converted to the block's units for a 1 kg block on a 1e5 N/m
 contact (delta_0 = 98 um, tau_0 = 3.2 ms; change with ``--mass``, ``--stiffness``).
 ``--time-stretch`` plays the record that many times slower.  BlockA.fmu (scaled
@@ -28,8 +28,8 @@ OUTPUTS = ("x", "z", "vx", "normal_force", "contact", "slip_count")
 def run_experiment(record_file, *, fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "out",
                    format=None, inventory=None, quantity=None, unit=None, peak_g=None, time_stretch=1.0,
                    mass=1.0, stiffness=1e5, freqmin=0.5, freqmax=None, step_size=0.25, show_plot=False):
-    from harness.excitation import plate_input, simulate_block
-    from harness.records import ModelScales, ProcessingSettings, load_ground_motion, scale_to_peak_acceleration
+    from harness.ground.excitation import plate_input, simulate_block
+    from harness.ground.records import ModelScales, ProcessingSettings, load_ground_motion, scale_to_peak_acceleration
 
     read = {key: value for key, value in (("format", format), ("inventory", inventory), ("quantity", quantity),
                                           ("unit", unit)) if value is not None}

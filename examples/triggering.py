@@ -8,7 +8,7 @@ each branch point, where the strong-motion part of obspy's bundled event (BW.RJO
 stretched 200x: ~600 tau_0 of strong shaking) hits it so that the record's peak
 arrives at the chosen phase of the stick.  Prints the table and saves
 out/triggering.png, out/triggering.csv and out/triggering.md.  See
-harness/triggering.py for the method and the expected physics.
+harness/ground/triggering.py for the method and the expected physics.
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ MARKERS = {"no effect": ("o", "0.6"), "reset, re-stuck": ("s", "tab:blue"), "ear
 
 def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "out", phases=None,
                    peak_accelerations=None, show_plot=False):
-    from harness.triggering import TriggeringSettings, run_triggering
+    from harness.ground.triggering import TriggeringSettings, run_triggering
 
     settings = TriggeringSettings(block_fmu=str(fmu))
     changes = {k: tuple(v) for k, v in (("phases", phases), ("peak_accelerations", peak_accelerations)) if v}

@@ -1,6 +1,6 @@
-"""``python -m harness ...``: the vibroblock command line (see harness.cli)."""
+"""``python -m harness ...``: the vibroblock command line (see harness.runs.cli)."""
 import sys
 
-from .cli import main
+from harness.runs.cli import main
 
 sys.exit(main())

@@ -2,7 +2,7 @@
 
     python -m harness.main [--quick] [--scheduler ADDRESS] [--workers N] [--out out]
 
-Runs the studies of :mod:`harness.claims` on a Dask LocalCluster (or the scheduler
+Runs the studies of :mod:`harness.paper.claims` on a Dask LocalCluster (or the scheduler
 given), persisting every sweep point and task under ``<out>/store`` so an interrupted
 job resumes where it stopped; draws the figures; writes the measured values
 (``<out>/claims.json``) and the report (``<out>/report.md``).  ``--quick`` is a
@@ -16,10 +16,10 @@ import sys
 import time
 from pathlib import Path
 
-from .claims import RESOLUTIONS, Runner, run_studies, save_studies
-from .fmu import REPO_ROOT
-from .report import write_report
-from .sweep import INLINE, Execution, close_client, open_client
+from harness.paper.claims import RESOLUTIONS, Runner, run_studies, save_studies
+from harness.cosim.fmu import REPO_ROOT
+from harness.paper.report import timing_lines, write_report
+from harness.runs.sweep import INLINE, Execution, close_client, open_client
 
 def main(argv: list[str] | None = None) -> Path:
     parser = argparse.ArgumentParser(prog="python -m harness.main", description=__doc__.splitlines()[0])
@@ -40,7 +40,7 @@ def main(argv: list[str] | None = None) -> Path:
     execution = Execution(scheduler=args.scheduler, workers=args.workers, progress=not args.no_progress)
     started = time.perf_counter()
     if args.report_only:
-        from .claims import load_studies
+        from harness.paper.claims import load_studies
 
         studies = load_studies(out / "claims.json")
         path = write_report(studies, out, (), {"resolution": "from claims.json"})
@@ -60,6 +60,8 @@ def main(argv: list[str] | None = None) -> Path:
               f"{runner.points_computed} / {runner.points_reused}", "wall time": f"{elapsed:.0f} s",
               "measured values": "claims.json"}
     path = write_report(studies, out, (), header)
+    for line in timing_lines(studies):
+        print(line)
     print(f"report: {path}  ({elapsed:.0f} s, resolution {resolution.name})")
     return path
 

@@ -75,7 +75,7 @@ N_COMPONENTS = 4
 DATA_DIR = Path(__file__).resolve().parent / "data"
 # Vertical ground motion of a local event at station BW.RJOB (Bavaria), 2009-08-24,
 # shipped with obspy; processed to consistent SI acceleration (m/s^2, dt in s) by
-# ``harness.excitation.write_bundled_record`` (how: see the archive's ``history``).
+# ``harness.ground.excitation.write_bundled_record`` (how: see the archive's ``history``).
 BUNDLED_RECORD = DATA_DIR / "bw_rjob_ehz_2009-08-24.npz"
 TEXT_SUFFIXES = (".csv", ".txt", ".dat")
 # A record file's velocity and displacement may differ from the exact integral of
@@ -203,7 +203,7 @@ class Playback:
         a = a_i + j tau,  v = v_i + a_i tau + j tau^2 / 2,  z = z_i + v_i tau + a_i tau^2 / 2 + j tau^3 / 6
 
     with j = (a_{i+1} - a_i) / dt and v_i, z_i from the same formulas at tau = dt (the
-    scheme of ``harness.records``), so v = dz/ds and a = dv/ds hold exactly inside each
+    scheme of ``harness.ground.records``), so v = dz/ds and a = dv/ds hold exactly inside each
     interval and z, v, a are continuous across samples up to rounding of the sums.
     """
 

@@ -27,17 +27,17 @@ import os
 import statistics
 import time
 
-from harness.fmu import InstancePool
-from harness.run import POINT_OUTPUTS, resolved_parameters, run_point
-from harness.settings import ObservableSettings, PointSettings, RunSettings
-from harness.sweep import (POOL_PLUGIN, Execution, FmuPoolPlugin, Grid, close_client, open_client, points_of,
+from harness.cosim.fmu import InstancePool
+from harness.runs.run import POINT_OUTPUTS, resolved_parameters, run_point
+from harness.runs.settings import ObservableSettings, PointSettings, RunSettings
+from harness.runs.sweep import (POOL_PLUGIN, Execution, FmuPoolPlugin, Grid, close_client, open_client, points_of,
                            run_sweep)
 
 
 def _warm(fmu: str, dask_worker=None) -> int:
     """Load the FMU on a worker and run it briefly, so timing starts from a warm worker."""
-    from harness.run import simulate
-    from harness.settings import RunSettings as Settings
+    from harness.runs.run import simulate
+    from harness.runs.settings import RunSettings as Settings
 
     pool = dask_worker.plugins[POOL_PLUGIN].pool
     simulate(Settings(fmu=fmu, horizon=10.0), pool)

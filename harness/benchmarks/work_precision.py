@@ -31,7 +31,7 @@ rtol (atol = rtol / 100).
 
 Non-chaotic scenarios are compared pointwise at the end: x and phi (errors relative to
 their reference values) and z (in delta_0, the rest penetration), the error being the
-largest of these.  The reference is ``harness.reference`` (independent of the core:
+largest of these.  The reference is ``harness.paper.reference`` (independent of the core:
 DOP853 at rtol = atol = 1e-12, restarts at every switch, switches sought at 16 points of
 each step's interpolant and steps capped to 1/16 of the plate period); its own error is
 estimated by running it again at 1e-11 and reported as the floor.  Peers: scipy's RK45,
@@ -132,7 +132,7 @@ def core_run(scenario: Scenario, integrator: str, dt: float, **tolerances):
 
 
 def scipy_run(scenario: Scenario, solver):
-    from harness import reference
+    from harness.paper import reference
 
     if scenario.window:
         times = np.arange(scenario.window[0], scenario.window[1] + 1e-9, 0.5)
@@ -172,7 +172,7 @@ def accuracy(scenario: Scenario, err: dict) -> float:
 def measure(scenario: Scenario, quick: bool, log):
     from vibroblock import INTEGRATORS
 
-    from harness.reference import Solver
+    from harness.paper.reference import Solver
 
     rows = []
     ref_seconds, ref = scipy_run(scenario, Solver.reference(1e-12))
@@ -336,7 +336,7 @@ def write_outputs(results, out: Path, total: float):
     lines = ["# Work-precision benchmark", "",
              "Regenerate: `python -m harness.benchmarks.work_precision` (writes this file and "
              "`work_precision.png`). All runs in one process, side by side; wall times on this machine "
-             f"(total {total:.0f} s). Errors against `harness.reference` (DOP853, rtol = atol = 1e-12, restarts at "
+             f"(total {total:.0f} s). Errors against `harness.paper.reference` (DOP853, rtol = atol = 1e-12, restarts at "
              "each switch, switches sought at 16 points per step; the floor is its change from 1e-11). Peers: "
              "scipy's RK45, LSODA, Radau with solve_ivp's event detection (sign at the step ends). "
              "Non-chaotic scenarios: largest of the relative errors of x and phi and the error of z (delta_0) "

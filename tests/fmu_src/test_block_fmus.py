@@ -242,7 +242,7 @@ def test_two_instances_in_one_process_are_independent(extracted, fmu_log):
 @pytest.mark.parametrize("model", "ABC")
 def test_libcosim_runs_the_fmus_with_the_same_results_as_fmpy(fmu_path, model):
     """A second FMI 2.0 master (DNV's libcosim, through libcosimpy)."""
-    from harness.masters.libcosim import run_libcosim
+    from harness.cosim.masters.libcosim import run_libcosim
 
     settings = {**SCALED, "A": 0.9, "omega": 1.1, "initial_state": 2, "integrator": 1}
     names = OUTPUTS + ["contact", "slip_count"]

@@ -12,7 +12,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2Error, fmi2OK
 from fmpy.validation import validate_fmu
 
 from fmu_testing import do_step, fmu_log, set_real, status_of  # noqa: F401 (fixture)
-from harness.masters import run_libcosim
+from harness.cosim.masters import run_libcosim
 from vibroblock.excitation import Excitation, load_record
 
 PLATE = ["plate_z", "plate_v", "plate_a"]

@@ -1,13 +1,13 @@
 """The readings of models B and C (``vibroblock.readings``, docs/physics.md): formulation,
 Coulomb bound and flight, checked against facts -- the reduction to model A, statics,
 Eq. (9)'s stick positions, the detachment onset, the energy balance, save/restore -- and
-against the independent reference (``harness.reference``)."""
+against the independent reference (``harness.paper.reference``)."""
 import math
 
 import numpy as np
 import pytest
 
-from harness import analytic, reference
+from harness.paper import analytic, reference
 from vibroblock import Block, ModelError
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}

@@ -7,8 +7,8 @@ import pytest
 from vibroblock import Block
 from vibroblock.block import ModelError
 
-from harness import reference
-from harness.reference import Solver
+from harness.paper import reference
+from harness.paper.reference import Solver
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 VALLEY_X = (-0.5 * math.pi + 0.005) / 0.02  # slope 0.1 of the paper's corrugation, near a valley

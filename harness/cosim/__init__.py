@@ -1,0 +1,2 @@
+"""FMI access and co-simulation masters: :mod:`.fmu` (extraction, instances, pools through
+fmpy), :mod:`.masters` (libcosim), :mod:`.ssp` (SSP files connecting Excitation -> Block)."""

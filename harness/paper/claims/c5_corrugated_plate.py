@@ -1,0 +1,122 @@
+"""C5 -- model B (corrugated plate): x(t) for several A at omega = 0.5, stick positions, k_t = 0.
+
+Criteria: C5a: at every A, mean slip interval and slip length within
+``UNCHANGED_TOLERANCE`` of A = 0.  C5b: median distance of stuck samples from the nearest
+stable root of Eq. (9) below ``ROOT_TOLERANCE`` wavelengths (k_t = 0 run).  C5c: the
+k_t = 0 run is in stick-slip."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .measure import OBSERVE_B, SCALED, VALLEY, WAVELENGTH, b_point, observe_json, run_and_measure
+from .study import Claim, Runner, Study
+from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, fmt, relative
+
+ROOT_TOLERANCE = 0.02
+
+TEXT = {
+    "C5a": "B: horizontal motion unaffected by the vibration",
+    "C5b": "B: stick positions are the stable roots of cos(omega_x x*) = K(x* - V_d t)",
+    "C5c": "B: stick-slip even with k_t = 0",
+}
+FIGURES = {
+    "C5a": ["model_b_x_t.png"],
+    "C5b": ["model_b_x_t.png"],
+    "C5c": ["model_b_x_t.png"],
+}
+
+
+def study_c5(runner: Runner) -> Study:
+    """Model B: x(t) for several A at omega = 0.5, stick positions, and k_t = 0."""
+    res = runner.resolution
+    omega = 0.5
+    items = [{"point": b_point(runner, res.b_horizon, OBSERVE_B, A=a, omega=omega),
+              "extras": ["trace", "stick_roots"]} for a in res.b_amplitudes]
+    items.append({"point": b_point(runner, res.b_horizon, OBSERVE_B, A=0.0, omega=omega, k_t=0.0),
+                  "extras": ["trace", "stick_roots"]})
+    results = runner.tasks(run_and_measure, items)
+    runs = []
+    for amplitude, result in zip(res.b_amplitudes, results):
+        obs = result["observables"]
+        runs.append({"A": amplitude, "peak_acceleration_over_g": amplitude * omega**2, "regime": obs["regime"],
+                     "slip_events": obs["slip_events"], "slip_interval": obs["slip_interval_mean"],
+                     "slip_length": obs["slip_length_mean"], "drift_velocity": obs["drift_velocity"],
+                     "contact_fraction": obs["contact_fraction"],
+                     "root_distance_median": result["root_distance_median"]})
+    reference = np.interp(results[0]["trace"]["time"], results[0]["trace"]["time"], results[0]["trace"]["x"])
+    for run, result in zip(runs, results):
+        other = np.interp(results[0]["trace"]["time"], result["trace"]["time"], result["trace"]["x"])
+        run["max_x_difference"] = float(np.max(np.abs(other - reference)))
+    frictionless = results[-1]
+    obs = frictionless["observables"]
+    measured = {"omega": omega, "runs": runs, "wavelength": WAVELENGTH, "V_d": SCALED["V_d"],
+                "frictionless": {"regime": obs["regime"], "slip_events": obs["slip_events"],
+                                 "slip_length": obs["slip_length_mean"],
+                                 "root_distance_median": frictionless["root_distance_median"],
+                                 "root_distance_p90": frictionless["root_distance_p90"]}}
+    settings = {"model": "B", "parameters": "paper plate (A_x = 1e3, omega_x = 2e-2), scaled drive "
+                "k_d = V_d = 1e-2, gamma_t = 5e-3", "omega": omega, "horizon": res.b_horizon,
+                "initial": f"valley x = 3 pi/(2 omega_x) = {VALLEY:.1f}, steady orbit, spring relaxed at t0",
+                **observe_json(OBSERVE_B)}
+    data = {"traces": [{"A": a, **r["trace"]} for a, r in zip(res.b_amplitudes, results)],
+            "frictionless_trace": frictionless["trace"]}
+    return Study("C5", measured, settings, data)
+
+
+def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
+    runs = m["runs"]
+    measured_a = "; ".join(f"A = {r['A']:g} (A w^2/g = {r['peak_acceleration_over_g']:.2g}): {r['slip_events']} slips, "
+                           f"every {fmt(r['slip_interval'])}, length {fmt(r['slip_length'])}, drift "
+                           f"{fmt(r['drift_velocity'])}, contact {fmt(r['contact_fraction'])}, max |x - x_(A=0)| "
+                           f"{fmt(r['max_x_difference'])}" for r in runs)
+    reference = runs[0]
+    if reference["slip_interval"] is None or not math.isfinite(float(reference["slip_interval"])):
+        row_a = Row("C5a", measured_a, NOT_REPRODUCED, "fewer than two complete slips at A = 0 in the window")
+    else:
+        worst = max(max(relative(r["slip_interval"], reference["slip_interval"]),
+                        relative(r["slip_length"], reference["slip_length"])) for r in runs)
+        row_a = Row("C5a", measured_a, AGREES if worst <= UNCHANGED_TOLERANCE else DISAGREES,
+                    f"largest change of slip interval or length from A = 0: {fmt(100 * worst, 2)} % "
+                    f"(tolerance {UNCHANGED_TOLERANCE:.0%})")
+    free = m["frictionless"]
+    distance = free["root_distance_median"]
+    measured_b = (f"k_t = 0: median distance of stuck samples from the nearest stable root {fmt(distance)} "
+                  f"(90th percentile {fmt(free['root_distance_p90'])}), wavelength {m['wavelength']:.3g}; with "
+                  f"friction (A = 0): {fmt(reference['root_distance_median'])}")
+    if distance is None:
+        row_b = Row("C5b", measured_b, NOT_REPRODUCED, "no stuck samples")
+    else:
+        ok = distance <= ROOT_TOLERANCE * m["wavelength"]
+        row_b = Row("C5b", measured_b, AGREES if ok else DISAGREES,
+                    f"median distance {'<=' if ok else '>'} {ROOT_TOLERANCE:g} wavelengths")
+    measured_c = f"k_t = 0: regime {free['regime']}, {free['slip_events']} slips of {fmt(free['slip_length'])}"
+    if free["regime"] == "stick_slip":
+        row_c = Row("C5c", measured_c, AGREES, "stick-slip without tangential spring")
+    elif free["regime"] == "stuck":
+        row_c = Row("C5c", measured_c, NOT_REPRODUCED, "no slip in the window (stuck): window shorter than a stick")
+    elif free["regime"] == "jammed":
+        row_c = Row("C5c", measured_c, DISAGREES, "jammed (self-locked on a flank) without tangential spring")
+    else:
+        row_c = Row("C5c", measured_c, DISAGREES, "sliding without tangential spring")
+    return row_a, row_b, row_c
+
+
+def draw(study: Study, save) -> None:
+    """The figures of this claim, each handed to ``save(figure, file name)``."""
+    import matplotlib.pyplot as plt
+
+    d = study.data
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for trace in d["traces"]:
+        ax.plot(trace["time"], trace["x"], label=f"A = {trace['A']:g}")
+    ax.plot(d["frictionless_trace"]["time"], d["frictionless_trace"]["x"], "k--", lw=0.8, label="A = 0, $k_t$ = 0")
+    t = np.asarray(d["traces"][0]["time"])
+    ax.plot(t, study.measured["V_d"] * t, "k:", lw=0.8, label="$V_d t$")
+    ax.set(xlabel=r"$t$", ylabel="x", title=f"Model B, $\\omega$ = {study.measured['omega']:g}")
+    ax.legend(fontsize="small")
+    save(fig, "model_b_x_t.png")
+
+
+CLAIM = Claim("C5", study_c5, verdict_c5, TEXT, FIGURES, draw)

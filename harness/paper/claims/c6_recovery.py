@@ -1,0 +1,220 @@
+"""C6 -- model C (confining load): both transitions in the A-omega plane, friction recovery at omega_2.
+
+Criteria: C6a: k_t = 0 run not in stick-slip.  C6b: in every A row that loses friction,
+the grid omegas bracketing the loss contain sqrt(P_l/(m A)).  C6c: every row that loses
+friction regains it (omega_2) and k_n/gamma_n lies within ``RECOVERY_SLACK`` of the
+bracket [last sliding omega, omega_2]; omega_2 equal in all rows.  C6d: at each
+k_n/gamma_n, omega_2 (in units of k_n/gamma_n) spreads over at most one grid step across
+k_n.  C6e: up and down ramps regain friction at the same omega."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from harness.paper.plots import regime_scatter
+from harness.runs.continuation import Ramp
+from harness.runs.settings import PointSettings
+from harness.runs.sweep import Axis, Grid
+
+from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, c_run, friction_held, observe_json, onset_amplitude,
+                      onset_omega, ramp_task, recovery, run_and_measure)
+from .study import Claim, Runner, Study
+from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, Row, combine, fmt
+
+RECOVERY_SLACK = 0.25
+
+TEXT = {
+    "C6a": "C: no stick-slip with k_t = 0",
+    "C6b": "C: first transition at A = P_l/(m omega^2)",
+    "C6c": "C: friction recovery at omega_2 ~ k_n/gamma_n, independent of A",
+    "C6d": "C: omega_2 weakly dependent on k_n at fixed k_n/gamma_n",
+    "C6e": "C: no hysteresis at omega_2",
+}
+FIGURES = {
+    "C6a": [],
+    "C6b": ["model_c_phase_diagram.png"],
+    "C6c": ["model_c_phase_diagram.png"],
+    "C6d": ["omega2_vs_k_n.png"],
+    "C6e": ["model_c_phase_diagram.png"],
+}
+
+
+def study_c6(runner: Runner) -> Study:
+    """Model C: k_t = 0, both transitions in the A-omega plane, omega_2 vs k_n, ramp across omega_2."""
+    res = runner.resolution
+    observe_c = OBSERVE_SHORT
+    # k_t = 0 and the ramp across omega_2 run as tasks, in parallel.
+    k_t_zero = {"point": PointSettings(run=c_run(runner, max(res.c_horizon, 8000.0), A=0.0, k_t=0.0),
+                                       observe=observe_c), "extras": ["trace"]}
+    ramp_amplitude = 0.5
+    ramp_item = {"point": PointSettings(run=c_run(runner, res.c6_ramp_step, A=ramp_amplitude), observe=observe_c),
+                 "ramp": Ramp("omega", res.c6_ramp)}
+    [frictionless] = runner.tasks(run_and_measure, [k_t_zero])
+    [loop] = runner.tasks(ramp_task, [ramp_item])
+
+    base = PointSettings(run=c_run(runner, res.c_horizon), observe=observe_c)
+    diagram = runner.sweep(Grid((Axis("A", res.c6_amplitudes), Axis("omega", res.c6_omegas))), base)
+    rows = []
+    for amplitude in diagram.A.values:
+        regimes = diagram.regime.sel(A=amplitude).values.tolist()
+        omegas = diagram.omega.values.tolist()
+        found = recovery(omegas, regimes)
+        rows.append({"A": float(amplitude), "regimes": regimes, **found,
+                     "first_transition_paper": math.sqrt(1.0 / float(amplitude)),
+                     "first_transition_onset": onset_omega(float(amplitude), 0.07)})
+
+    stiffness_amplitude = 0.5
+    base_k = PointSettings(run=c_run(runner, res.c_horizon, A=stiffness_amplitude), observe=observe_c)
+    grid_k = Grid((Axis("ratio", res.c6_ratios), Axis("k_n", res.c6_stiffnesses),
+                   Axis("relative_omega", res.c6_relative_omegas)),
+                  derived={"gamma_n": "k_n / ratio", "omega": "relative_omega * ratio"})
+    stiff = runner.sweep(grid_k, base_k)
+    recovery_vs_k = []
+    for ratio in stiff.ratio.values:
+        for k_n in stiff.k_n.values:
+            regimes = stiff.regime.sel(ratio=ratio, k_n=k_n).values.tolist()
+            omegas = (stiff.relative_omega.values * ratio).tolist()
+            found = recovery(omegas, regimes)
+            recovery_vs_k.append({"ratio": float(ratio), "k_n": float(k_n), "regimes": regimes, "omegas": omegas,
+                                  **found})
+
+    up = [(v, r) for d, v, r in zip(loop["direction"], loop["value"], loop["regime"]) if d == "up"]
+    down = [(v, r) for d, v, r in zip(loop["direction"], loop["value"], loop["regime"]) if d == "down"]
+    up_rec = recovery([v for v, _ in up], [r for _, r in up])
+    # Coming down from high omega, friction is lost at the highest sliding value.
+    down_sliding = [v for v, r in down if not friction_held(r)]
+    down_friction_above = [v for v, r in down if friction_held(r) and (not down_sliding or v > max(down_sliding))]
+    measured = {
+        "k_n_over_gamma_n": 1.0 / 0.07,
+        "frictionless": {"regime": frictionless["observables"]["regime"],
+                         "slip_events": frictionless["observables"]["slip_events"],
+                         "phi": frictionless["observables"]["phi"],
+                         "drift_velocity": frictionless["observables"]["drift_velocity"]},
+        "diagram_rows": rows, "omegas": diagram.omega.values.tolist(),
+        "stiffness_amplitude": stiffness_amplitude, "recovery_vs_k": recovery_vs_k,
+        "ramp_amplitude": ramp_amplitude, "ramp_values": list(res.c6_ramp),
+        "ramp_up_omega_2": up_rec["omega_2"],
+        "ramp_down_omega_2": min(down_friction_above) if down_friction_above else None,
+        "ramp_up_regimes": [r for _, r in up], "ramp_down_regimes": [r for _, r in down],
+    }
+    settings = {"model": "C", "parameters": C_PARAMETERS, "horizon": res.c_horizon, "initial": C_START,
+                "ramp_step": res.c6_ramp_step, **observe_json(observe_c),
+                "friction": "regime stick_slip or stuck (not sliding)"}
+    data = {"omega": diagram.omega.values.tolist(), "A": diagram.A.values.tolist(),
+            "regime": diagram.regime.transpose("A", "omega").values.tolist(),
+            "recovery_vs_k": recovery_vs_k, "loop": loop}
+    return Study("C6", measured, settings, data)
+
+
+def verdict_c6(m: dict) -> list[Row]:
+    rows = []
+    free = m["frictionless"]
+    measured = (f"k_t = 0, A = 0: regime {free['regime']}, phi {fmt(free['phi'])}, drift {fmt(free['drift_velocity'])}, "
+                f"{free['slip_events']} slips")
+    rows.append(Row("C6a", measured, DISAGREES if free["regime"] == "stick_slip" else AGREES,
+                    f"regime {free['regime']}"))
+
+    diagram = m["diagram_rows"]
+    losing = [r for r in diagram if r["omega_1"] is not None]
+    measured = "; ".join(f"A = {r['A']:g}: friction lost at w in ({fmt(r['last_friction_before_1'])}, "
+                         f"{fmt(r['omega_1'])}] (sqrt(P_l/mA) = {r['first_transition_paper']:.3g}, "
+                         f"A_c onset {fmt(r['first_transition_onset'])}), regained at {fmt(r['omega_2'])}"
+                         for r in diagram)
+    if not losing:
+        rows.append(Row("C6b", measured, NOT_REPRODUCED, "no row loses friction in the scanned omega range"))
+    else:
+        ok = [r for r in losing if (r["last_friction_before_1"] is None
+                                    or r["last_friction_before_1"] <= r["first_transition_paper"])
+              and r["first_transition_paper"] <= r["omega_1"]]
+        rows.append(Row("C6b", measured, AGREES if len(ok) == len(losing) else DISAGREES,
+                        f"sqrt(P_l/mA) bracketed in {len(ok)}/{len(losing)} rows that lose friction"))
+
+    ratio = m["k_n_over_gamma_n"]
+    recovered = [r for r in losing if r["omega_2"] is not None]
+    measured = (f"k_n/gamma_n = {ratio:.3g}; omega_2 per A: "
+                + ", ".join(f"A = {r['A']:g}: {fmt(r['omega_2'])}" for r in losing))
+    if not losing:
+        rows.append(Row("C6c", measured, NOT_REPRODUCED, "no sliding region to recover from"))
+    elif not recovered:
+        rows.append(Row("C6c", measured, DISAGREES,
+                        f"no row regains friction up to w = {max(m['omegas']):g}"))
+    else:
+        near = [r for r in recovered if r["last_sliding"] * (1 - RECOVERY_SLACK) <= ratio
+                <= r["omega_2"] * (1 + RECOVERY_SLACK)]
+        same = len({r["omega_2"] for r in recovered}) == 1
+        parts = [(AGREES if len(recovered) == len(losing) else DISAGREES,
+                  f"{len(recovered)}/{len(losing)} rows that lose friction regain it"),
+                 (AGREES if len(near) == len(recovered) else DISAGREES,
+                  f"k_n/gamma_n within the recovery bracket (+-{RECOVERY_SLACK:.0%}) in {len(near)}/{len(recovered)}"),
+                 (AGREES if same else DISAGREES, "omega_2 the same grid value in all rows" if same
+                  else "omega_2 differs between rows")]
+        verdict, reason = combine(parts)
+        rows.append(Row("C6c", measured, verdict, reason))
+
+    by_ratio: dict[float, list] = {}
+    for entry in m["recovery_vs_k"]:
+        by_ratio.setdefault(entry["ratio"], []).append(entry)
+    measured = "; ".join(f"k_n/gamma_n = {r:g}: " + ", ".join(
+        f"k_n = {e['k_n']:g}: w2/(k_n/gamma_n) = {fmt(e['omega_2'] / r if e['omega_2'] else None)}"
+        for e in entries) + f" (A = {m['stiffness_amplitude']:g})" for r, entries in by_ratio.items())
+    parts = []
+    for r, entries in by_ratio.items():
+        found = [e["omega_2"] / r for e in entries if e["omega_2"] is not None]
+        if len(found) < len(entries):
+            parts.append((NOT_REPRODUCED, f"ratio {r:g}: no recovery for {len(entries) - len(found)} k_n"))
+            continue
+        grid = sorted(set(round(o / r, 9) for o in entries[0]["omegas"]))
+        positions = [min(range(len(grid)), key=lambda i: abs(grid[i] - f)) for f in found]
+        parts.append((AGREES if max(positions) - min(positions) <= 1 else DISAGREES,
+                      f"ratio {r:g}: w2 spans {max(positions) - min(positions)} grid steps over k_n"))
+    verdict, reason = combine(parts) if parts else (NOT_REPRODUCED, "no data")
+    rows.append(Row("C6d", measured, verdict, reason))
+
+    up, down = m["ramp_up_omega_2"], m["ramp_down_omega_2"]
+    measured = (f"ramp at A = {m['ramp_amplitude']:g}, w = {m['ramp_values']}: up {m['ramp_up_regimes']}, down "
+                f"{m['ramp_down_regimes']}; friction back at w = {fmt(up)} (up), held down to {fmt(down)} (down)")
+    if up is None or "sliding" not in m["ramp_up_regimes"]:
+        rows.append(Row("C6e", measured, NOT_REPRODUCED, "the up ramp shows no sliding -> friction recovery"))
+    else:
+        rows.append(Row("C6e", measured, AGREES if up == down else DISAGREES,
+                        "same recovery value up and down" if up == down else "recovery differs up and down"))
+    return rows
+
+
+def draw(study: Study, save) -> None:
+    """The figures of this claim, each handed to ``save(figure, file name)``."""
+    import matplotlib.pyplot as plt
+
+    d = study.data
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    omega, amplitude = np.meshgrid(d["omega"], d["A"])
+    regime_scatter(ax, omega.ravel(), amplitude.ravel(), np.asarray(d["regime"]).ravel())
+    line = np.geomspace(min(d["omega"]), max(d["omega"]), 300)
+    ax.plot(line, 1 / line**2, "k:", label=r"$A = P_l/(m\omega^2)$")
+    ax.plot(line, onset_amplitude(line), "k-", lw=1, label=r"$A_c(\omega)$ with $P_l$")
+    ax.axvline(study.measured["k_n_over_gamma_n"], color="tab:green", ls="--", label=r"$k_n/\gamma_n$")
+    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A", title="Model C")
+    ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
+    ax.legend(fontsize="small")
+    save(fig, "model_c_phase_diagram.png")
+
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    by_ratio: dict[float, list] = {}
+    for entry in d["recovery_vs_k"]:
+        by_ratio.setdefault(entry["ratio"], []).append(entry)
+    for number, (ratio, entries) in enumerate(by_ratio.items()):
+        ks = [e["k_n"] for e in entries if e["omega_2"] is not None]
+        ws = [e["omega_2"] for e in entries if e["omega_2"] is not None]
+        ax.plot(ks, ws, "o-", color=f"C{number}", label=f"$k_n/\\gamma_n$ = {ratio:g}")
+        missing = [e["k_n"] for e in entries if e["omega_2"] is None]
+        if missing:
+            ax.plot(missing, [ratio * 0.1] * len(missing), "x", color=f"C{number}")
+        ax.axhline(ratio, color=f"C{number}", ls=":", lw=0.8)
+    ax.set(xscale="log", yscale="log", xlabel="$k_n$", ylabel=r"$\omega_2$",
+           title="Friction recovery (x: none found; dotted: $k_n/\\gamma_n$)")
+    ax.legend(fontsize="small")
+    save(fig, "omega2_vs_k_n.png")
+
+
+CLAIM = Claim("C6", study_c6, verdict_c6, TEXT, FIGURES, draw)

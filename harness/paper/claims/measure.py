@@ -1,0 +1,221 @@
+"""Conventions, worker tasks and regime arithmetic the claim studies share.
+
+Conventions used by all studies
+-------------------------------
+* Model A uses the ``scaled`` preset (k_d = V_d = 1e-2, gamma_t = 5e-3): the paper's
+  drive makes one stick-slip cycle ~5e7 tau_0.  Models B and C use the paper's plate
+  (A_x = 1e3, omega_x = 2e-2, P_l = 1) with the same scaled drive.
+* Vibrated runs start on the steady in-contact orbit (``steady_orbit``).  Models B and
+  C start at a valley (B) or a crest (C) of the corrugation, at the time when the drive
+  spring is relaxed (start_time = x_start / V_d), so that no spring force acts at t0.
+* "Friction" = the block is held by friction in the window: regime stick_slip, stuck
+  (no slip and no sliding within the window) or jammed (self-locked on a flank);
+  "sliding" = it follows the drive; "flying" = no contact in the window (not friction).
+"""
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import numpy as np
+
+from harness.runs.continuation import continuation
+from harness.runs.observables import FLYING, SLIDING, observe, window, window_slips
+from harness.runs.run import simulate
+from harness.runs.settings import PRESETS, InitialCondition, ObservableSettings, PointSettings, RunSettings
+
+from .study import Runner
+
+SCALED = dict(PRESETS["scaled"])
+OMEGA_X = 2e-2
+VALLEY = 3 * math.pi / (2 * OMEGA_X)  # sin(omega_x x) = -1
+CREST = math.pi / (2 * OMEGA_X)       # sin(omega_x x) = +1
+WAVELENGTH = 2 * math.pi / OMEGA_X
+TRACE_POINTS = 3000  # samples kept of a trajectory for figures
+
+# Observation settings per use (all reported with the results).
+OBSERVE_A = ObservableSettings(transient=4000.0)
+# Vibration splits slips into short bursts separated by tangential ringing; bursts closer
+# than merge_gap are one slip, and slips down to 5 % of mu_s m g / k_d count.
+OBSERVE_A_BURSTS = ObservableSettings(transient=4000.0, slip_min_fraction=0.05, merge_gap=100.0)
+OBSERVE_SHORT = ObservableSettings(transient=2000.0)
+OBSERVE_B = ObservableSettings(transient=5000.0, merge_gap=100.0)
+
+
+def jsonable_float(value) -> float | None:
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def trace(ds, points: int = TRACE_POINTS) -> dict:
+    stride = max(1, len(ds.time) // points)
+    return {"time": ds.time.values[::stride].tolist(), "x": ds.x.values[::stride].tolist()}
+
+
+# ---------------------------------------------------------------------- worker tasks
+def run_and_measure(item: dict, pool) -> dict:
+    """One run: observables plus the extras named in ``item["extras"]`` (worker task)."""
+    point: PointSettings = item["point"]
+    extras = item.get("extras", ())
+    outputs = ("x", "vx", "phi_integral", "contact", "slip_count", "penetration")
+    ds = simulate(point.run, pool, outputs=outputs)
+    result = {"observables": observe(ds, point.observe).as_dict()}
+    win = window(ds, point.observe.transient, point.observe.window)
+    part = win.slice()
+    t, x, vx = ds.time.values[part], ds.x.values[part], ds.vx.values[part]
+    v_d = float(ds.attrs["V_d"])
+    if "rest_penetration" in extras:
+        result["rest_penetration"] = float(np.mean(ds.penetration.values[part]))
+    if "creep" in extras:
+        result["creep_velocity"] = _creep_velocity(ds, win, point.observe)
+    if "offset" in extras:
+        # Stationary sliding x = V_d t - x0: x0 is the mean lag behind the drive.
+        result["offset"] = float(np.mean(v_d * t - x))
+        result["offset_std"] = float(np.std(v_d * t - x))
+    if "trace" in extras:
+        result["trace"] = trace(ds)
+    if "stick_roots" in extras:
+        result.update(_stick_root_distances(ds, t, x, vx, v_d))
+    return result
+
+
+def _creep_velocity(ds, win, settings: ObservableSettings) -> float | None:
+    """Median slope of x over the middle half of each complete stick phase in the window."""
+    slips = window_slips(ds, win, settings)
+    t, x = ds.time.values, ds.x.values
+    slopes = []
+    for begin, end in zip(slips.end[:-1], slips.onset[1:]):
+        lo, hi = begin + 0.25 * (end - begin), begin + 0.75 * (end - begin)
+        chosen = (t >= lo) & (t <= hi)
+        if chosen.sum() >= 3:
+            slopes.append(np.polyfit(t[chosen], x[chosen], 1)[0])
+    return jsonable_float(np.median(slopes)) if slopes else None
+
+
+def stable_roots_near(x: float, drive: float, k_ratio: float, omega_x: float = OMEGA_X) -> float:
+    """The stable root x* of cos(omega_x x*) = K (x* - drive) nearest to x (sin(omega_x x*) < 0),
+    searched within one wavelength either side; nan if none."""
+    span = 2 * math.pi / omega_x
+    grid = np.linspace(x - span, x + span, 4001)
+    h = np.cos(omega_x * grid) - k_ratio * (grid - drive)
+    change = np.flatnonzero(np.sign(h[:-1]) != np.sign(h[1:]))
+    if not len(change):
+        return math.nan
+    roots = grid[change] - h[change] * (grid[change + 1] - grid[change]) / (h[change + 1] - h[change])
+    roots = roots[np.sin(omega_x * roots) < 0]
+    if not len(roots):
+        return math.nan
+    return float(roots[np.argmin(np.abs(roots - x))])
+
+
+def _stick_root_distances(ds, t, x, vx, v_d) -> dict:
+    """Distances of the stuck block from the nearest stable root of the paper's Eq. (9)."""
+    a = ds.attrs
+    k_ratio = -a["k_d"] / (a["A_x"] * a["omega_x"] * a["m"] * a["g"])
+    stuck = np.flatnonzero(np.abs(vx) < 0.2 * abs(v_d))
+    if not len(stuck):
+        return {"stick_samples": 0, "root_distance_median": None, "root_distance_p90": None}
+    chosen = stuck[np.linspace(0, len(stuck) - 1, min(400, len(stuck))).astype(int)]
+    distances = np.array([abs(x[i] - stable_roots_near(x[i], v_d * t[i], k_ratio, a["omega_x"])) for i in chosen])
+    distances = distances[np.isfinite(distances)]
+    return {"stick_samples": int(len(stuck)), "stick_share": float(len(stuck) / len(x)),
+            "root_distance_median": jsonable_float(np.median(distances)) if len(distances) else None,
+            "root_distance_p90": jsonable_float(np.percentile(distances, 90)) if len(distances) else None}
+
+
+def ramp_task(item: dict, pool) -> dict:
+    """A continuation ramp (worker task): per step direction, value, regime, phi, contact."""
+    ds = continuation(item["point"], item["ramp"], pool)
+    parameter = item["ramp"].parameter
+    return {"direction": ds.direction.values.tolist(), "value": ds[parameter].values.tolist(),
+            "regime": ds.regime.values.tolist(), "phi": ds.phi.values.tolist(),
+            "contact_fraction": ds.contact_fraction.values.tolist()}
+
+
+# ---------------------------------------------------------------------- helpers
+def friction_held(regime: str) -> bool:
+    """Held by friction in the window: stick-slip, stuck or jammed (not sliding, not flying)."""
+    return regime not in (SLIDING, FLYING)
+
+
+def first_sliding(values: Sequence[float], regimes: Sequence[str]) -> float | None:
+    """First value (in the given order) whose regime is sliding."""
+    for value, regime in zip(values, regimes):
+        if regime == SLIDING:
+            return float(value)
+    return None
+
+
+def regime_changes(regimes: Sequence[str]) -> int:
+    held = [friction_held(r) for r in regimes]
+    return int(sum(a != b for a, b in zip(held[:-1], held[1:])))
+
+
+def transition_bracket(values: Sequence[float], regimes: Sequence[str]) -> tuple[float | None, float | None]:
+    """(value just below the first sliding one, first sliding value) along ascending values;
+    (largest value, None) when nothing slides."""
+    first = first_sliding(values, regimes)
+    if first is None:
+        return float(values[-1]), None
+    index = list(values).index(first)
+    return (float(values[index - 1]) if index > 0 else None), first
+
+
+def onset_amplitude(omega, load: float = 1.0, m: float = 1.0, k_n: float = 1.0, gamma_n: float = 0.07):
+    """A_c(omega) of the steady in-contact orbit, with the load m g (A, B) or P_l (C):
+    ``vibroblock.orbits.detachment_amplitude`` with g = load / m."""
+    from vibroblock.orbits import detachment_amplitude
+    return detachment_amplitude(omega, m=m, g=load / m, k_n=k_n, gamma_n=gamma_n)
+
+
+def observe_json(observe_settings: ObservableSettings) -> dict:
+    return {"phi_threshold": observe_settings.phi_threshold, "transient": observe_settings.transient,
+            "window": "rest of run" if observe_settings.window is None else observe_settings.window,
+            "slip_min_fraction": observe_settings.slip_min_fraction, "merge_gap": observe_settings.merge_gap}
+
+
+def relaxed_start(x_start: float, v_d: float) -> float:
+    return x_start / v_d
+
+
+
+def onset_omega(amplitude: float, gamma_n: float, load: float = 1.0, k_n: float = 1.0) -> float | None:
+    """Lowest omega at which A_c(omega) falls to ``amplitude`` (bisection on a fine grid)."""
+    grid = np.geomspace(1e-3, 100.0, 20001)
+    below = np.flatnonzero(onset_amplitude(grid, load, 1.0, k_n, gamma_n) <= amplitude)
+    return float(grid[below[0]]) if len(below) else None
+
+
+def b_point(runner: Runner, horizon: float, observe_settings: ObservableSettings, **parameters) -> PointSettings:
+    values = {**SCALED, **parameters}
+    run = runner.run("B", parameters=values, horizon=horizon, output_interval=2.0,
+                     initial=InitialCondition("steady_orbit", x_start=VALLEY),
+                     start_time=relaxed_start(VALLEY, values["V_d"]))
+    return PointSettings(run=run, observe=observe_settings)
+
+
+def c_run(runner: Runner, horizon: float, **parameters) -> RunSettings:
+    values = {**SCALED, **parameters}
+    return runner.run("C", parameters=values, horizon=horizon, initial=InitialCondition("steady_orbit", x_start=CREST),
+                      start_time=relaxed_start(CREST, values["V_d"]))
+
+
+C_START = f"crest x = pi/(2 omega_x) = {CREST:.1f}, steady orbit, spring relaxed at t0"
+C_PARAMETERS = "paper plate (A_x = 1e3, omega_x = 2e-2, P_l = 1), scaled drive k_d = V_d = 1e-2, gamma_t = 5e-3"
+
+
+def recovery(values: Sequence[float], regimes: Sequence[str]) -> dict:
+    """Along ascending omega: omega_1 (first sliding) and omega_2 (first value above omega_1
+    held by friction again), with the values bracketing each."""
+    omega_1 = first_sliding(values, regimes)
+    out = {"omega_1": omega_1, "omega_2": None, "last_sliding": None, "last_friction_before_1": None}
+    if omega_1 is None:
+        return out
+    index_1 = list(values).index(omega_1)
+    out["last_friction_before_1"] = float(values[index_1 - 1]) if index_1 > 0 else None
+    for i in range(index_1 + 1, len(values)):
+        if friction_held(regimes[i]):
+            out["omega_2"] = float(values[i])
+            out["last_sliding"] = float(values[i - 1])
+            break
+    return out

@@ -1,0 +1,193 @@
+"""What every claim's study shares: its sizes (:class:`Resolution`), its result
+(:class:`Study`), the :class:`Runner` that executes and caches its runs, and the
+:class:`Claim` record a claim module registers.
+
+A study runs sweeps (through :func:`harness.runs.sweep.run_sweep`, persisted in the
+runner's point store) and single runs or continuation ramps (through
+:func:`harness.runs.sweep.map_with_pool`, each result cached as JSON under
+``<store>/studies`` keyed by its inputs and the FMU's sha256), and returns plain numbers.
+The claim's verdict function turns those numbers into verdicts by explicit criteria.
+
+Sizes (grid points, horizons, ramp steps) come from a :class:`Resolution`; ``default``
+is the main job's, ``quick`` a one-minute version, ``tiny`` the tests'.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from harness.cosim.fmu import fmu_sha256
+from harness.runs.settings import PointSettings, RunSettings, canonical_json, default_fmu, to_jsonable
+from harness.runs.store import write_json_atomically
+from harness.runs.sweep import OBSERVABLES_VERSION, Execution, Grid, map_with_pool, run_sweep
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Sizes of the studies (see module doc)."""
+
+    name: str
+    horizon_a: float           # model A runs and sweep points
+    c2_amplitudes: tuple
+    c3_omegas: tuple
+    c3_amplitudes: tuple
+    c4_gammas: tuple
+    c4_omegas: tuple           # down to below the bouncing-ball floor of the two smallest gamma_n
+    c4_step: float             # duration of a ramp step
+    b_horizon: float           # model B x(t) runs
+    b_amplitudes: tuple
+    c_horizon: float           # model C sweep points
+    c6_amplitudes: tuple
+    c6_omegas: tuple
+    c6_ratios: tuple           # k_n / gamma_n
+    c6_stiffnesses: tuple      # k_n
+    c6_relative_omegas: tuple  # omega / (k_n / gamma_n)
+    c6_ramp: tuple
+    c6_ramp_step: float
+    c7_omegas: tuple
+    contact_horizon: float
+    c8_velocities: tuple
+    c8_omegas: tuple
+
+
+RESOLUTIONS = {
+    "default": Resolution(
+        name="default", horizon_a=20_000.0, c2_amplitudes=(0.0, 4.0, 8.0, 12.0, 15.0),
+        c3_omegas=tuple(np.round(np.geomspace(0.1, 4.0, 9), 4)),
+        c3_amplitudes=tuple(np.round(np.geomspace(0.02, 300.0, 10), 4)),
+        c4_gammas=(0.035, 0.07, 0.14, 0.28), c4_omegas=tuple(np.round(np.arange(0.075, 0.5001, 0.025), 4)),
+        c4_step=12_000.0, b_horizon=100_000.0, b_amplitudes=(0.0, 1.0, 2.5, 5.0, 10.0), c_horizon=10_000.0,
+        c6_amplitudes=(0.1, 0.3, 1.0, 3.0, 10.0, 30.0), c6_omegas=tuple(np.round(np.geomspace(0.1, 50.0, 10), 4)),
+        c6_ratios=(7.0, 14.29, 28.57), c6_stiffnesses=(0.5, 1.0, 2.0),
+        c6_relative_omegas=(0.25, 0.5, 1.0, 1.5, 2.0, 3.0), c6_ramp=(5.0, 8.0, 11.0, 14.0, 17.0, 22.0, 30.0, 40.0),
+        c6_ramp_step=8_000.0, c7_omegas=tuple(np.round(np.geomspace(0.1, 50.0, 10), 4)), contact_horizon=5_000.0,
+        c8_velocities=(1e-3, 1e-2, 0.1, 1.0, 10.0), c8_omegas=(0.1, 0.3, 1.0, 3.0, 10.0, 30.0)),
+    "quick": Resolution(
+        name="quick", horizon_a=14_000.0, c2_amplitudes=(0.0, 8.0, 15.0), c3_omegas=(0.1, 0.3, 1.0, 3.0),
+        c3_amplitudes=(0.03, 0.3, 3.0, 30.0, 300.0), c4_gammas=(0.035, 0.07, 0.28),
+        c4_omegas=(0.08, 0.12, 0.2, 0.3, 0.4, 0.5), c4_step=8_000.0, b_horizon=40_000.0, b_amplitudes=(0.0, 5.0),
+        c_horizon=5_000.0, c6_amplitudes=(0.3, 3.0), c6_omegas=(0.1, 1.0, 5.0, 14.0, 40.0),
+        c6_ratios=(7.0, 14.29), c6_stiffnesses=(1.0, 2.0), c6_relative_omegas=(0.5, 2.0),
+        c6_ramp=(5.0, 14.0, 40.0), c6_ramp_step=4_000.0, c7_omegas=(0.1, 1.0, 14.0, 40.0),
+        contact_horizon=3_000.0, c8_velocities=(1e-2, 10.0), c8_omegas=(0.3, 3.0)),
+    "tiny": Resolution(
+        name="tiny", horizon_a=6_000.0, c2_amplitudes=(0.0, 8.0), c3_omegas=(0.2, 2.0), c3_amplitudes=(0.1, 100.0),
+        c4_gammas=(0.07, 0.28), c4_omegas=(0.25, 0.45), c4_step=3_000.0, b_horizon=8_000.0, b_amplitudes=(0.0, 5.0),
+        c_horizon=3_000.0, c6_amplitudes=(3.0,), c6_omegas=(0.3, 14.0), c6_ratios=(14.29,), c6_stiffnesses=(1.0,),
+        c6_relative_omegas=(0.5, 2.0), c6_ramp=(5.0, 30.0), c6_ramp_step=2_500.0, c7_omegas=(0.3, 14.0),
+        contact_horizon=2_500.0, c8_velocities=(10.0,), c8_omegas=(0.3,)),
+}
+
+
+@dataclass
+class Study:
+    """What one claim's study measured.
+
+    ``measured``: the numbers the verdict is computed from (JSON-able);
+    ``settings``: parameter set, start, threshold, window, transient per part;
+    ``data``: arrays for the figures (JSON-able lists);
+    ``timing``: wall time of the study and what of it came from the store (:func:`timing`)."""
+
+    claim: str
+    measured: dict
+    settings: dict
+    data: dict = field(default_factory=dict)
+    timing: dict = field(default_factory=dict)
+
+
+class Runner:
+    """Runs sweeps and cached tasks for the studies on one Dask client (or inline)."""
+
+    def __init__(self, store: str | os.PathLike, resolution: Resolution, execution: Execution = Execution(),
+                 client=None, fmus: dict | None = None):
+        self.store = Path(store)
+        self.resolution = resolution
+        self.execution = execution
+        self.client = client
+        self.fmus = {m: str((fmus or {}).get(m, default_fmu(m))) for m in "ABC"}
+        self._sha = {m: fmu_sha256(path) for m, path in self.fmus.items()}
+        self.points_computed = 0
+        self.points_reused = 0
+        self.tasks_computed = 0
+        self.tasks_reused = 0
+
+    def run(self, model: str, **fields) -> RunSettings:
+        return RunSettings(fmu=self.fmus[model], **fields)
+
+    def sweep(self, grid: Grid, base: PointSettings):
+        outcome = run_sweep(grid, base, self.store / "points", self.execution, self.client)
+        self.points_computed += outcome.computed
+        self.points_reused += outcome.reused
+        return outcome.dataset
+
+    def tasks(self, function: Callable, items: Sequence[dict]) -> list[dict]:
+        """``function(item, pool)`` for every item, cached by (function, item, FMU hashes)."""
+        folder = self.store / "studies"
+        keys = []
+        for item in items:
+            text = canonical_json({"function": f"{function.__module__}.{function.__qualname__}", "item": item,
+                                   "fmu_sha256": self._sha, "observables_version": OBSERVABLES_VERSION})
+            keys.append(hashlib.sha256(text.encode()).hexdigest())
+        results: dict[int, dict] = {}
+        for number, key in enumerate(keys):
+            path = folder / f"{key}.json"
+            if path.exists():
+                results[number] = json.loads(path.read_text())["result"]
+        missing = [n for n in range(len(items)) if n not in results]
+        self.tasks_computed += len(missing)
+        self.tasks_reused += len(items) - len(missing)
+        if missing:
+            computed = map_with_pool(function, [items[n] for n in missing], self.execution, self.client)
+            for number, result in zip(missing, computed):
+                write_json_atomically(folder / f"{keys[number]}.json", {"item": to_jsonable(items[number]),
+                                                                        "result": result})
+                results[number] = result
+        return [results[n] for n in range(len(items))]
+
+
+def counts(runner: Runner) -> dict:
+    """What the runner has computed and reused from its store so far."""
+    return {"points_computed": runner.points_computed, "points_reused": runner.points_reused,
+            "tasks_computed": runner.tasks_computed, "tasks_reused": runner.tasks_reused}
+
+
+def timing(wall_time: float, before: dict, after: dict) -> dict:
+    """A study's wall time and its points and tasks computed or read from the store, from the
+    runner's :func:`counts` before and after it; ``source`` says where its results came from."""
+    spent = {key: after[key] - before[key] for key in after}
+    computed = spent["points_computed"] + spent["tasks_computed"]
+    reused = spent["points_reused"] + spent["tasks_reused"]
+    source = "store" if reused and not computed else "computed" if not reused else "partly from the store"
+    return {"wall_time": wall_time, "source": source, **spent}
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One claim of DESIGN.md as the report sees it: its study, the verdict rows computed
+    from what the study measured, the statement of each part and the figures of each part.
+
+    ``verdicts(measured) -> list[Row]`` is None for a study that only draws a figure
+    (Fig. 1b); ``draw(study, save)`` hands each figure to ``save(figure, file name)``."""
+
+    name: str
+    study: Callable[[Runner], Study]
+    verdicts: Callable[[dict], list] | None = None
+    text: dict = field(default_factory=dict)
+    figures: dict = field(default_factory=dict)
+    draw: Callable | None = None
+
+
+def save_studies(studies: dict[str, Study], path: str | os.PathLike) -> None:
+    write_json_atomically(Path(path), {name: dataclasses.asdict(s) for name, s in studies.items()})
+
+
+def load_studies(path: str | os.PathLike) -> dict[str, Study]:
+    data = json.loads(Path(path).read_text())
+    return {name: Study(**fields) for name, fields in data.items()}

@@ -1,0 +1,104 @@
+"""Figures from harness results (matplotlib; every function draws on a given or new Axes
+and returns it, so figures compose and scripts can save them without a display).
+
+* :func:`plot_trajectories` -- x(t) of runs against the drive's x = V_d t (Fig. 1b).
+* :func:`plot_phase_diagram` -- regimes of a two-dimensional sweep, with the paper's
+  line A = g / omega^2 and, if given, another onset curve (Fig. 1c, model C).
+* :func:`regime_scatter` -- regime markers at given points (the claims' diagrams).
+* :func:`plot_hysteresis` -- phi along continuation ramps, up and down branches (C4).
+"""
+from __future__ import annotations
+
+from typing import Callable, Mapping
+
+import numpy as np
+import xarray as xr
+
+from harness.runs.observables import FLYING, JAMMED, SLIDING, STICK_SLIP, STUCK
+
+REGIME_STYLE = {
+    STICK_SLIP: {"marker": "s", "color": "tab:red", "label": "stick-slip"},
+    SLIDING: {"marker": "o", "color": "tab:blue", "label": "sliding"},
+    STUCK: {"marker": "x", "color": "tab:gray", "label": "no slip in window"},
+    JAMMED: {"marker": "v", "color": "tab:purple", "label": "jammed (self-locked)"},
+    FLYING: {"marker": "^", "color": "tab:green", "label": "flying (no contact)"},
+}
+
+
+def _axes(ax):
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    return plt.figure().add_subplot()
+
+
+def regime_scatter(ax, xs, ys, regimes):
+    """One marker per point (xs[i], ys[i]) in the style of its regime, one legend entry per regime."""
+    xs, ys, regimes = np.asarray(xs), np.asarray(ys), np.asarray(regimes)
+    for name, style in REGIME_STYLE.items():
+        chosen = regimes == name
+        if chosen.any():
+            ax.scatter(xs[chosen], ys[chosen], marker=style["marker"], color=style["color"], label=style["label"])
+
+
+def plot_trajectories(runs: Mapping[str, xr.Dataset], ax=None, drive: bool = True):
+    """x(t) of each run (label -> trajectory Dataset); the drive's V_d t as a dashed line."""
+    ax = _axes(ax)
+    for label, ds in runs.items():
+        ax.plot(ds.time, ds.x, label=label)
+    if drive and runs:
+        first = next(iter(runs.values()))
+        ax.plot(first.time, first.attrs["V_d"] * first.time, "k--", lw=0.8, label="$V_d t$")
+    ax.set_xlabel(r"$t$ [$\tau_0$]")
+    ax.set_ylabel(r"$x$ [$\delta_0$]")
+    ax.legend()
+    return ax
+
+
+def plot_phase_diagram(sweep: xr.Dataset, x: str = "omega", y: str = "A", ax=None, paper_line: bool = True,
+                       onset: Callable[[np.ndarray], np.ndarray] | None = None, onset_label: str = "onset",
+                       log_y: bool = False):
+    """Regime markers over a sweep with dimensions (x, y); optional transition lines.
+
+    ``paper_line`` draws A = g / omega^2 (g from the sweep's attributes, or P_l / m for
+    model C); ``onset`` is any other curve y(x), e.g. ``vibroblock.detachment_amplitude``.
+    """
+    ax = _axes(ax)
+    xs, ys = np.meshgrid(sweep[x].values, sweep[y].values)
+    regime_scatter(ax, xs.ravel(), ys.ravel(), sweep["regime"].transpose(y, x).values.ravel())
+    grid = np.linspace(sweep[x].values.min(), sweep[x].values.max(), 200)
+    grid = grid[grid > 0]
+    if paper_line and x == "omega" and y == "A":
+        load = sweep.attrs.get("g", sweep.attrs.get("P_l", 1.0) / sweep.attrs.get("m", 1.0))
+        ax.plot(grid, load / grid**2, "k:", label=r"$A = g/\omega^2$")
+    if onset is not None:
+        ax.plot(grid, onset(grid), "k-", lw=1, label=onset_label)
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    if log_y:
+        ax.set_yscale("log")
+    span = sweep[y].values
+    ax.set_ylim(span.min() * (0.8 if log_y else 1) - (0 if log_y else 0.05 * np.ptp(span)),
+                span.max() * (1.25 if log_y else 1) + (0 if log_y else 0.05 * np.ptp(span)))
+    ax.legend(fontsize="small")
+    return ax
+
+
+def plot_hysteresis(loops: Mapping[str, xr.Dataset], ax=None, log_phi: bool = True):
+    """phi against the ramped parameter, up (filled) and down (open) per loop (label -> Dataset)."""
+    ax = _axes(ax)
+    for number, (label, ds) in enumerate(loops.items()):
+        parameter = ds.attrs["ramp_parameter"]
+        color = f"C{number}"
+        for direction, fill in (("up", color), ("down", "none")):
+            part = ds.where(ds.direction == direction, drop=True)
+            if part.sizes.get("step", 0):
+                ax.plot(part[parameter], part.phi, marker="s" if direction == "up" else "o", color=color,
+                        markerfacecolor=fill, label=f"{label} ({direction})")
+        ax.set_xlabel(parameter)
+    ax.set_ylabel(r"$\phi$")
+    if log_phi:
+        ax.set_yscale("log")
+    ax.legend(fontsize="small")
+    return ax

@@ -1,0 +1,120 @@
+"""Measured values -> verdicts, figures and ``out/report.md``.
+
+The report iterates the registry :data:`harness.paper.claims.CLAIMS`: each claim's module
+computes its rows of the claims table from the numbers its study measured (its docstring
+states the criteria) and draws its figures.  Nothing in the table is written by hand.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Sequence
+
+from .claims import CLAIMS, Study
+from .claims.verdicts import AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row
+
+CLAIM_TEXT = {part: text for claim in CLAIMS.values() for part, text in claim.text.items()}
+FIGURES = {part: files for claim in CLAIMS.values() for part, files in claim.figures.items()}
+
+
+def claim_rows(studies: dict[str, Study]) -> list[Row]:
+    """Every row of the claims table, from the studies' measured values."""
+    rows: list[Row] = []
+    for name, claim in CLAIMS.items():
+        if claim.verdicts is None or name not in studies:
+            continue
+        made = claim.verdicts(studies[name].measured)
+        made = [made] if isinstance(made, Row) else list(made)
+        for row in made:
+            row.figures = FIGURES.get(row.claim, [])
+            row.settings = _settings_text(studies[name].settings)
+        rows.extend(made)
+    return rows
+
+
+def _settings_text(settings: dict) -> str:
+    keys = ("model", "models", "parameters", "initial", "horizon", "step_duration", "phi_threshold", "transient",
+            "window")
+    return "; ".join(f"{k}: {settings[k]}" for k in keys if k in settings)
+
+
+def _cell(text: str) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), header: dict | None = None) -> str:
+    rows = claim_rows(studies)
+    header = header or {}
+    lines = ["# vibroblock: claims C1-C8 against our simulations", ""]
+    if header:
+        lines += [f"- {k}: {v}" for k, v in header.items()] + [""]
+    lines += ["Verdicts are computed from the measured numbers by the criteria stated in each claim's module (`harness/paper/claims/`) "
+              f"(relative tolerance {FORMULA_TOLERANCE:.0%} for formulas, {UNCHANGED_TOLERANCE:.0%} for 'unchanged', "
+              "bracket tests on the sweep grids). 'Friction' means regime stick_slip or stuck (held in the window); "
+              "'sliding' means following the drive (phi below the threshold, drift >= V_d/2).", "",
+              "| claim | statement | measured | verdict | why | figures |", "|---|---|---|---|---|---|"]
+    summary = {}
+    for row in rows:
+        figures = " ".join(f"[{f}]({f})" for f in row.figures if f in figures_present)
+        lines.append(f"| {row.claim} | {_cell(CLAIM_TEXT[row.claim])} | {_cell(row.measured)} | **{row.verdict}** | "
+                     f"{_cell(row.reason)} | {figures} |")
+        summary[row.verdict] = summary.get(row.verdict, 0) + 1
+    lines += ["", "Summary: " + ", ".join(f"{v}: {n}" for v, n in sorted(summary.items())), "",
+              "## Parameter sets and classification per study", "",
+              "| study | settings |", "|---|---|"]
+    for name, study in studies.items():
+        lines.append(f"| {name} | {_cell(_settings_text(study.settings))}; merge gap {study.settings.get('merge_gap', 'n/a')}, "
+                     f"min slip fraction {study.settings.get('slip_min_fraction', 'n/a')} |")
+    timed = {name: study.timing for name, study in studies.items() if study.timing}
+    if timed:
+        lines += ["", "## Time per study", "", "| study | wall time | from | points computed / from the store | "
+                  "runs and ramps computed / from the store |", "|---|---|---|---|---|"]
+        lines += [f"| {name} | {t['wall_time']:.1f} s | {t['source']} | {t['points_computed']} / {t['points_reused']} "
+                  f"| {t['tasks_computed']} / {t['tasks_reused']} |" for name, t in timed.items()]
+    if figures_present:
+        lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures_present]
+    return "\n".join(lines) + "\n"
+
+
+def make_figures(studies: dict[str, Study], out: str | os.PathLike) -> list[str]:
+    """Draw every figure the studies allow into ``out``; the file names written."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+
+    def save(fig, name):
+        fig.tight_layout()
+        fig.savefig(out / name, dpi=120)
+        plt.close(fig)
+        written.append(name)
+
+    for name, claim in CLAIMS.items():
+        if claim.draw is not None and name in studies:
+            claim.draw(studies[name], save)
+    return written
+
+
+def timing_lines(studies: dict[str, Study]) -> list[str]:
+    """One line per study: its wall time and where its results came from (for the main job's output)."""
+    return [f"{name}: {s.timing['wall_time']:.1f} s ({s.timing['source']}; points {s.timing['points_computed']} "
+            f"computed / {s.timing['points_reused']} from the store, runs and ramps {s.timing['tasks_computed']} / "
+            f"{s.timing['tasks_reused']})" for name, s in studies.items() if s.timing]
+
+
+def write_report(studies: dict[str, Study], out: str | os.PathLike, extra_figures: Sequence[str] = (),
+                 header: dict | None = None) -> Path:
+    """Figures and ``<out>/report.md`` from the studies; the report's path."""
+    out = Path(out)
+    figures = list(extra_figures) + make_figures(studies, out)
+    path = out / "report.md"
+    path.write_text(markdown(studies, figures, header))
+    return path
+
+
+__all__ = ["AGREES", "CLAIM_TEXT", "DISAGREES", "FIGURES", "NOT_REPRODUCED", "Row", "claim_rows", "make_figures",
+           "markdown", "timing_lines", "write_report"]

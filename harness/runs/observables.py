@@ -1,0 +1,289 @@
+"""Observables of a run: pure functions of its trajectory Dataset.
+
+Every function takes a Dataset as :func:`harness.runs.run.simulate` returns it (variables
+``x``, ``vx``, optionally ``phi_integral``, ``contact``, ``slip_count`` over ``time``;
+the drive velocity ``V_d`` and the other parameters as attributes) and a measuring
+window; :func:`observe` computes them all under one :class:`ObservableSettings`
+and returns an :class:`Observables` record that states its window, transient and
+threshold.
+
+Window: [t_from, t_to] with t_to the last sample and t_from = max(start + transient,
+t_to - window) (window None: start + transient), snapped to the first sample at or
+after it.
+
+Definitions
+-----------
+* phi = <(vx - V_d)^2> / V_d^2 over the window (the paper's order parameter).  From the
+  FMU's exact running integral ``phi_integral`` when recorded, otherwise by the
+  trapezoidal rule on the samples.
+* regime, from what the block does in the window (rules applied in this order):
+  "flying" if it never touches the plate (no contact sample); "stick_slip" if
+  phi > threshold; "sliding" if it keeps up with the drive (drift velocity >= half of
+  V_d); "jammed" if it neither slips nor keeps up while the drive spring's stretch
+  V_d t - x grows and ends beyond the flat surface's Coulomb limit mu_s N0 / k_d (the
+  paper's slip length, N0 = m g or P_l): held by more than friction on a flat plate
+  could hold, i.e. self-locked on a flank (docs/physics.md, "Self-locking"); else
+  "stuck": no slip and no sliding in a window shorter than a stick phase (phi = 1 for
+  a block at rest, below any sensible threshold): lengthen the window to classify.
+* drift velocity: (x(t_to) - x(t_from)) / (t_to - t_from).
+* contact fraction: share of the window's samples with ``contact`` true (sampled at the
+  output interval, so it resolves contact phases longer than that interval).
+* slips (:func:`slip_events`): velocity runs with hysteresis and a minimum advance; a
+  slip touching either end of the window is incomplete and not counted.  Stick time is
+  the time from the end of one slip to the onset of the next; slip interval the time
+  between consecutive onsets; slip length the advance of x over the slip (from the
+  last sample before it to the first sample after it).
+* coulomb_resets: increase of the FMU's ``slip_count`` over the window, for
+  information only (it depends on dt and counts the cascades before a detachment).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import xarray as xr
+
+from .settings import ObservableSettings
+
+STICK_SLIP, SLIDING, STUCK, JAMMED, FLYING = "stick_slip", "sliding", "stuck", "jammed", "flying"
+REGIMES = (STICK_SLIP, SLIDING, STUCK, JAMMED, FLYING)
+# A block drifting slower than this share of V_d over a window without slips is stuck.
+STUCK_DRIFT_FRACTION = 0.5
+
+
+@dataclass(frozen=True)
+class Window:
+    start: float
+    end: float
+    first: int  # index of the first sample in the window
+    last: int   # index of the last sample (inclusive)
+
+    @property
+    def duration(self) -> float:
+        return self.end - self.start
+
+    def slice(self) -> slice:
+        return slice(self.first, self.last + 1)
+
+
+def window(ds: xr.Dataset, transient: float = 0.0, length: float | None = None) -> Window:
+    """The measuring window of ``ds`` (see module doc); at least two samples or ValueError."""
+    t = ds["time"].values
+    t_from = t[0] + transient
+    if length is not None:
+        t_from = max(t_from, t[-1] - length)
+    # A tolerance keeps a window boundary that falls on a sample up to rounding.
+    first = int(np.searchsorted(t, t_from - 1e-9 * max(1.0, abs(t_from))))
+    last = len(t) - 1
+    if last - first < 1:
+        raise ValueError(f"the window starting at t = {t_from:g} holds fewer than two samples of the run "
+                         f"[{t[0]:g}, {t[-1]:g}]: shorten the transient or run longer")
+    return Window(float(t[first]), float(t[last]), first, last)
+
+
+def drive_velocity(ds: xr.Dataset) -> float:
+    try:
+        return float(ds.attrs["V_d"])
+    except KeyError:
+        raise KeyError("the Dataset has no V_d attribute (drive velocity)") from None
+
+
+def phi(ds: xr.Dataset, win: Window) -> float:
+    """Order parameter <(vx - V_d)^2> / V_d^2 over the window."""
+    v_d = drive_velocity(ds)
+    if v_d == 0.0:
+        return math.nan
+    if "phi_integral" in ds:
+        integral = ds["phi_integral"].values
+        mean_square = (integral[win.last] - integral[win.first]) / win.duration
+    else:
+        t = ds["time"].values[win.slice()]
+        deviation = ds["vx"].values[win.slice()] - v_d
+        mean_square = np.trapezoid(deviation**2, t) / win.duration
+    return float(mean_square / v_d**2)
+
+
+def classify(phi_value: float, threshold: float, drift: float = math.nan, v_d: float = math.nan) -> str:
+    """Regime from phi, and (to tell sliding from stuck) the drift and drive velocities."""
+    if phi_value > threshold:
+        return STICK_SLIP
+    if abs(drift) < STUCK_DRIFT_FRACTION * abs(v_d):
+        return STUCK
+    return SLIDING
+
+
+def refine(regime: str, ds: xr.Dataset, win: Window, contact: float) -> str:
+    """The rules that need the trajectory: flying (no contact in the window) and jammed
+    (stuck with the drive spring's stretch growing beyond the flat surface's Coulomb
+    limit); see the module doc."""
+    if contact == 0.0:
+        return FLYING
+    if regime != STUCK:
+        return regime
+    v_d = drive_velocity(ds)
+    time, x = ds["time"].values, ds["x"].values
+    stretch_start = v_d * time[win.first] - x[win.first]
+    stretch_end = v_d * time[win.last] - x[win.last]
+    growing = abs(stretch_end) > abs(stretch_start)
+    return JAMMED if growing and abs(stretch_end) > nominal_slip_length(ds.attrs) else STUCK
+
+
+def drift_velocity(ds: xr.Dataset, win: Window) -> float:
+    x = ds["x"].values
+    return float((x[win.last] - x[win.first]) / win.duration)
+
+
+def contact_fraction(ds: xr.Dataset, win: Window) -> float:
+    if "contact" not in ds:
+        return math.nan
+    return float(np.mean(ds["contact"].values[win.slice()]))
+
+
+def coulomb_resets(ds: xr.Dataset, win: Window) -> int:
+    if "slip_count" not in ds:
+        return -1
+    counts = ds["slip_count"].values
+    return int(counts[win.last] - counts[win.first])
+
+
+def nominal_slip_length(attrs) -> float:
+    """mu_s N0 / k_d, the paper's slip length, with N0 = m g (models A, B) or P_l (C)."""
+    load = attrs["P_l"] if "P_l" in attrs else attrs.get("m", 1.0) * attrs.get("g", 1.0)
+    k_d = attrs.get("k_d", 0.0)
+    return attrs.get("mu_s", 0.0) * load / k_d if k_d > 0 else math.inf
+
+
+@dataclass(frozen=True)
+class SlipEvents:
+    """Completed slips in a window: onset and end times, advance of x."""
+
+    onset: np.ndarray
+    end: np.ndarray
+    length: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return len(self.onset)
+
+    @property
+    def stick_times(self) -> np.ndarray:
+        return self.onset[1:] - self.end[:-1]
+
+    @property
+    def intervals(self) -> np.ndarray:
+        return np.diff(self.onset)
+
+
+def slip_events(time: np.ndarray, x: np.ndarray, vx: np.ndarray, onset_velocity: float, release_velocity: float,
+                min_length: float, merge_gap: float = 0.0) -> SlipEvents:
+    """Slips in sampled (time, x, vx).
+
+    1. Candidates: maximal runs of samples with vx > release_velocity that contain a
+       sample with vx > onset_velocity (hysteresis: small wiggles around one threshold
+       do not split a slip, and creep below the release velocity is never a slip).
+    2. Candidates whose gap (first sample of one - last sample of the previous) is at most
+       merge_gap are merged into one slip.
+    3. A run touching the first or last sample is incomplete and dropped.
+    4. A slip spans from the last sample before its run to the first sample after it;
+       its length is the advance of x over that span; slips shorter than min_length
+       (the back-and-forth of tangential ringing) are dropped.
+    """
+    time, x, vx = (np.asarray(a, dtype=float) for a in (time, x, vx))
+    moving = vx > release_velocity
+    edges = np.diff(moving.astype(np.int8))
+    starts = list(np.flatnonzero(edges == 1) + 1)
+    ends = list(np.flatnonzero(edges == -1))
+    if moving.size and moving[0]:
+        starts.insert(0, 0)
+    if moving.size and moving[-1]:
+        ends.append(moving.size - 1)
+    runs = [(s, e) for s, e in zip(starts, ends) if np.any(vx[s:e + 1] > onset_velocity)]
+    merged: list[list[int]] = []
+    for s, e in runs:
+        if merged and time[s] - time[merged[-1][1]] <= merge_gap:
+            merged[-1][1] = e
+        else:
+            merged.append([s, e])
+    onset, end, length = [], [], []
+    last = len(time) - 1
+    for s, e in merged:
+        if s == 0 or e == last:
+            continue
+        advance = x[e + 1] - x[s - 1]
+        if advance >= min_length:
+            onset.append(time[s - 1])
+            end.append(time[e + 1])
+            length.append(advance)
+    return SlipEvents(np.array(onset), np.array(end), np.array(length))
+
+
+def window_slips(ds: xr.Dataset, win: Window, settings: ObservableSettings) -> SlipEvents:
+    v_d = abs(drive_velocity(ds))
+    min_length = settings.slip_min_length
+    if min_length is None:
+        nominal = nominal_slip_length(ds.attrs)
+        min_length = settings.slip_min_fraction * nominal if math.isfinite(nominal) else 0.0
+    part = win.slice()
+    return slip_events(ds["time"].values[part], ds["x"].values[part], ds["vx"].values[part],
+                       settings.slip_onset * v_d, settings.slip_release * v_d, min_length, settings.merge_gap)
+
+
+def _mean(values: np.ndarray) -> float:
+    return float(np.mean(values)) if len(values) else math.nan
+
+
+def _std(values: np.ndarray) -> float:
+    return float(np.std(values)) if len(values) > 1 else math.nan
+
+
+@dataclass(frozen=True)
+class Observables:
+    """The observables of one run, with the settings that produced them."""
+
+    phi: float
+    regime: str
+    slip_events: int  # slips seen in the motion (not the FMU's slip_count, which counts Coulomb resets)
+    stick_time_mean: float
+    stick_time_std: float
+    slip_interval_mean: float
+    slip_length_mean: float
+    slip_length_std: float
+    contact_fraction: float
+    drift_velocity: float
+    coulomb_resets: int
+    window_start: float
+    window_end: float
+    transient: float
+    phi_threshold: float
+
+    @property
+    def stick_slip(self) -> bool:
+        return self.regime == STICK_SLIP
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+# Observables that vary from point to point (the rest are settings, reported as attributes).
+MEASURED = ("phi", "regime", "slip_events", "stick_time_mean", "stick_time_std", "slip_interval_mean",
+            "slip_length_mean", "slip_length_std", "contact_fraction", "drift_velocity", "coulomb_resets",
+            "window_start", "window_end")
+
+
+def observe(ds: xr.Dataset, settings: ObservableSettings = ObservableSettings()) -> Observables:
+    """All observables of a run under one set of observable settings."""
+    win = window(ds, settings.transient, settings.window)
+    value = phi(ds, win)
+    drift = drift_velocity(ds, win)
+    slips = window_slips(ds, win, settings)
+    contact = contact_fraction(ds, win)
+    regime = refine(classify(value, settings.phi_threshold, drift, drive_velocity(ds)), ds, win, contact)
+    return Observables(
+        phi=value, regime=regime, slip_events=slips.count,
+        stick_time_mean=_mean(slips.stick_times), stick_time_std=_std(slips.stick_times),
+        slip_interval_mean=_mean(slips.intervals),
+        slip_length_mean=_mean(slips.length), slip_length_std=_std(slips.length),
+        contact_fraction=contact, drift_velocity=drift,
+        coulomb_resets=coulomb_resets(ds, win), window_start=win.start, window_end=win.end,
+        transient=settings.transient, phi_threshold=settings.phi_threshold)

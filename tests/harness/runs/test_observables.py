@@ -1,0 +1,166 @@
+"""Observables on synthetic signals whose answers are known in closed form."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from harness.runs.observables import (FLYING, JAMMED, SLIDING, STICK_SLIP, STUCK, classify, contact_fraction,
+                                      drift_velocity, observe, phi, slip_events, window)
+from harness.runs.settings import ObservableSettings
+
+V_D = 0.01
+PERIOD = 1000.0      # stick-slip cycle
+SLIP_TIME = 60.0     # duration of each slip
+SLIP_LENGTH = V_D * PERIOD  # the block keeps up with the drive on average
+DT = 0.1
+
+
+def cumulative(t, v):
+    out = np.zeros_like(v)
+    out[1:] = np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))
+    return out
+
+
+def stick_slip_signal(cycles=6, ringing=0.0, first_onset=500.0):
+    """Half-sine slips of length SLIP_LENGTH every PERIOD, optional ringing after each."""
+    t = np.arange(0.0, first_onset + cycles * PERIOD + DT / 2, DT)
+    vx = np.zeros_like(t)
+    peak = math.pi * SLIP_LENGTH / (2 * SLIP_TIME)
+    onsets = first_onset + PERIOD * np.arange(cycles)
+    for onset in onsets:
+        inside = (t >= onset) & (t <= onset + SLIP_TIME)
+        vx[inside] = peak * np.sin(math.pi * (t[inside] - onset) / SLIP_TIME)
+        if ringing:
+            tail = (t > onset + SLIP_TIME + 20) & (t < onset + SLIP_TIME + 400)
+            tau = t[tail] - onset - SLIP_TIME - 20
+            vx[tail] = ringing * np.sin(2 * math.pi * tau / 12.0) * np.exp(-tau / 150.0)
+    return t, vx, onsets
+
+
+def dataset(t, vx, contact=None, phi_integral=None, **attrs):
+    data = {"x": ("time", cumulative(t, vx)), "vx": ("time", vx)}
+    if contact is not None:
+        data["contact"] = ("time", contact)
+    if phi_integral is not None:
+        data["phi_integral"] = ("time", phi_integral)
+    base = {"V_d": V_D, "mu_s": 0.5, "m": 1.0, "g": 1.0, "k_d": 0.5 / SLIP_LENGTH}
+    return xr.Dataset(data, coords={"time": t}, attrs={**base, **attrs})
+
+
+def expected_phi():
+    # Over whole cycles: (integral of vx^2 - 2 V_d L + V_d^2 P) / (P V_d^2), with L = V_d P.
+    peak = math.pi * SLIP_LENGTH / (2 * SLIP_TIME)
+    square = peak**2 * SLIP_TIME / 2
+    return (square - 2 * V_D * SLIP_LENGTH + V_D**2 * PERIOD) / (PERIOD * V_D**2)
+
+
+def test_phi_of_stick_slip_cycles_matches_closed_form():
+    t, vx, _ = stick_slip_signal()
+    ds = dataset(t, vx)
+    win = window(ds, transient=500.0 - 100.0, length=4 * PERIOD)  # exactly four whole cycles
+    assert win.duration == pytest.approx(4 * PERIOD)
+    assert phi(ds, win) == pytest.approx(expected_phi(), rel=1e-4)
+    assert expected_phi() > ObservableSettings().phi_threshold
+
+
+def test_phi_uses_the_exact_integral_when_recorded():
+    t, vx, _ = stick_slip_signal()
+    integral = 3.0 * V_D**2 * (t - t[0])  # a run whose <(vx - V_d)^2> is exactly 3 V_d^2
+    ds = dataset(t, vx, phi_integral=integral)
+    assert phi(ds, window(ds, 1000.0)) == pytest.approx(3.0, rel=1e-12)
+
+
+def test_sliding_with_the_drive_has_small_phi_and_no_slips():
+    t = np.arange(0.0, 5000.0, 1.0)
+    vx = V_D * (1 + 0.3 * np.sin(0.5 * t))
+    ds = dataset(t, vx)
+    result = observe(ds, ObservableSettings(transient=1000.0))
+    assert result.phi == pytest.approx(0.045, rel=0.05)  # <(0.3 sin)^2> = 0.045
+    assert result.regime == SLIDING and not result.stick_slip
+    assert result.slip_events == 0 and math.isnan(result.stick_time_mean)
+    assert result.drift_velocity == pytest.approx(V_D, rel=1e-3)
+
+
+def test_slip_statistics_ignore_the_ringing_after_each_slip():
+    t, vx, onsets = stick_slip_signal(cycles=6, ringing=30 * V_D)  # ringing swings above the onset velocity
+    ds = dataset(t, vx)
+    assert vx[(t > onsets[0] + SLIP_TIME + 20) & (t < onsets[0] + SLIP_TIME + 60)].max() > 10 * V_D
+    result = observe(ds, ObservableSettings(transient=0.0))
+    assert result.slip_events == 6
+    assert result.slip_length_mean == pytest.approx(SLIP_LENGTH, rel=2e-3)
+    assert result.slip_interval_mean == pytest.approx(PERIOD, abs=2 * DT)
+    # A slip lasts while vx > V_d (the release velocity): a little less than SLIP_TIME.
+    peak = math.pi * SLIP_LENGTH / (2 * SLIP_TIME)
+    above_release = SLIP_TIME - 2 * SLIP_TIME / math.pi * math.asin(V_D / peak)
+    assert result.stick_time_mean == pytest.approx(PERIOD - above_release, abs=2 * DT)
+    assert result.regime == STICK_SLIP
+    # Without the length criterion every ringing lobe above the onset would count.
+    raw = slip_events(t, ds.x.values, vx, 10 * V_D, V_D, min_length=0.0)
+    assert raw.count > 6
+
+
+def test_a_slip_cut_by_the_window_start_is_not_counted():
+    t, vx, onsets = stick_slip_signal(cycles=5)
+    ds = dataset(t, vx)
+    settings = ObservableSettings(transient=onsets[1] + SLIP_TIME / 2)  # window opens mid-slip
+    result = observe(ds, settings)
+    assert result.slip_events == 3
+    assert result.window_start == pytest.approx(onsets[1] + SLIP_TIME / 2)
+    assert result.transient == settings.transient and result.phi_threshold == settings.phi_threshold
+
+
+def test_merge_gap_joins_a_slip_interrupted_by_a_short_pause():
+    t = np.arange(0.0, 1000.0, DT)
+    vx = np.zeros_like(t)
+    for start in (400.0, 433.0):  # two halves of 30 time units, 3 apart
+        inside = (t >= start) & (t <= start + 30.0)
+        vx[inside] = 0.2 * np.sin(math.pi * (t[inside] - start) / 30.0)
+    # vx stays below the release velocity V_d for 3 + 2 (30/pi) asin(0.05) ~ 4 time units.
+    x = cumulative(t, vx)
+    half = x[-1] / 2
+    apart = slip_events(t, x, vx, 10 * V_D, V_D, min_length=1.5 * half)
+    joined = slip_events(t, x, vx, 10 * V_D, V_D, min_length=1.5 * half, merge_gap=8.0)
+    assert apart.count == 0
+    assert joined.count == 1 and joined.length[0] == pytest.approx(2 * half, rel=1e-3)
+
+
+def test_contact_fraction_drift_and_classification():
+    t = np.arange(0.0, 1001.0, 1.0)
+    contact = (np.arange(t.size) % 4) == 0  # one sample in four
+    ds = dataset(t, np.full_like(t, 2 * V_D), contact=contact)
+    win = window(ds, 1.0)
+    assert contact_fraction(ds, win) == pytest.approx(0.25, abs=2e-3)
+    assert drift_velocity(ds, win) == pytest.approx(2 * V_D)
+    assert classify(10.5, 10.0) == STICK_SLIP and classify(9.5, 10.0, 0.9 * V_D, V_D) == SLIDING
+    assert classify(1.0, 10.0, 0.01 * V_D, V_D) == STUCK
+
+
+def test_a_window_without_slips_and_without_drift_is_stuck_or_jammed_by_the_spring_stretch():
+    # The drive spring's stretch reaches 0.97 V_d 3000 = 29.1 at the end of the window:
+    # jammed when that is beyond mu_s m g / k_d (the flat plate's slip length), stuck below.
+    t = np.arange(0.0, 3000.0, 1.0)
+    creeping = np.full_like(t, 0.03 * V_D)
+    settings = ObservableSettings(transient=100.0)
+    short_stick = observe(dataset(t, creeping, k_d=0.5 / 20.0), settings)   # slip length 20 < 29.1
+    long_stick = observe(dataset(t, creeping, k_d=0.5 / 40.0), settings)    # slip length 40 > 29.1
+    assert short_stick.phi == pytest.approx(0.97**2) and short_stick.regime == JAMMED
+    assert long_stick.regime == STUCK and not long_stick.stick_slip
+    # Confined by P_l (model C) instead of m g: the same rule with N0 = P_l.
+    assert observe(dataset(t, creeping, k_d=0.5 / 20.0, P_l=2.0), settings).regime == STUCK
+
+
+def test_a_block_that_never_touches_the_plate_is_flying_whatever_its_phi():
+    t, vx, _ = stick_slip_signal()
+    in_contact = observe(dataset(t, vx, contact=np.ones_like(t, dtype=bool)), ObservableSettings(transient=0.0))
+    airborne = observe(dataset(t, vx, contact=np.zeros_like(t, dtype=bool)), ObservableSettings(transient=0.0))
+    assert in_contact.regime == STICK_SLIP and airborne.regime == FLYING
+
+
+def test_a_window_without_two_samples_is_refused():
+    t = np.arange(0.0, 10.0, 1.0)
+    ds = dataset(t, np.zeros_like(t))
+    with pytest.raises(ValueError, match="fewer than two samples"):
+        window(ds, transient=9.5)

@@ -1,0 +1,89 @@
+"""Sweeps: grids, equality with direct runs, worker-side FMU reuse."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from harness.runs.observables import MEASURED
+from harness.runs.run import run_point
+from harness.runs.settings import ObservableSettings, PointSettings, RunSettings
+from harness.runs.sweep import (INLINE, Axis, Execution, Grid, SweepError, close_client, evaluate_expression, open_client,
+                           points_of, run_sweep, worker_pool_loads)
+
+
+def base_point(fmu, horizon=3000.0, transient=500.0):
+    return PointSettings(RunSettings.for_model("A", fmu=str(fmu), horizon=horizon),
+                         ObservableSettings(transient=transient))
+
+
+def test_axis_and_grid_parsing():
+    np.testing.assert_allclose(Axis.parse("A=0.1:2:8").values, np.linspace(0.1, 2, 8))
+    np.testing.assert_allclose(Axis.parse("V_d=1e-3:1e-1:3:log").values, [1e-3, 1e-2, 1e-1])
+    assert Axis.parse("omega=0.2, 0.5,1").values == (0.2, 0.5, 1.0)
+    assert Axis.parse("A=2").values == (2.0,)
+    for bad in ("A", "A=", "A=1:2", "A=1:2:3:cubic", "A=x", "A=1,1"):
+        with pytest.raises(ValueError):
+            Axis.parse(bad)
+    grid = Grid.parse(["A=0:1:3", "omega=0.5,0.7"], ["gamma_n=A/10"])
+    assert grid.shape == (3, 2) and len(grid) == 6 and grid.derived == (("gamma_n", "A/10"),)
+
+
+def test_derived_expressions_are_arithmetic_only():
+    assert evaluate_expression("k_n / ratio + 2**2 - sqrt(4)", {"k_n": 6.0, "ratio": 3.0}) == 4.0
+    for bad in ("__import__('os').getcwd()", "k_n.real", "[1][0]", "lambda: 1", "unknown * 2"):
+        with pytest.raises(ValueError):
+            evaluate_expression(bad, {"k_n": 1.0})
+
+
+def test_grid_with_a_derived_parameter_holds_the_ratio_fixed(fmu_a, tmp_path):
+    grid = Grid.parse(["k_n=1,2", "ratio=10,20"], ["gamma_n=k_n/ratio"])
+    base = base_point(fmu_a, horizon=60.0, transient=10.0)
+    points = points_of(grid, base)
+    for point in points:
+        values = point.inputs["fmu_values"]
+        assert values["gamma_n"] == pytest.approx(values["k_n"] / point.coordinates["ratio"])
+    ds = run_sweep(grid, base, tmp_path / "store", Execution(scheduler=INLINE, progress=False)).dataset
+    assert ds.phi.dims == ("k_n", "ratio")
+    np.testing.assert_allclose(ds.gamma_n.values, ds.k_n.values[:, None] / ds.ratio.values[None, :])
+    with pytest.raises(ValueError, match="not a parameter"):
+        points_of(Grid.parse(["stiffness=1,2"]), base)
+
+
+def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a):
+    grid = Grid.parse(["A=0,3.5", "omega=0.5,0.9"])
+    base = base_point(fmu_a)
+    client = open_client(Execution(workers=2))
+    try:
+        outcome = run_sweep(grid, base, None, Execution(progress=False), client=client)
+        loads = worker_pool_loads(client)
+        worker_numba = set(client.run(lambda: os.environ.get("NUMBA_CACHE_DIR")).values())
+    finally:
+        close_client(client)
+    assert outcome.computed == 4 and outcome.reused == 0
+    # 4 points on 2 workers: some worker evaluated several, and none loaded the FMU twice.
+    assert sorted(loads.values()) in ([1, 1], [0, 1])
+    assert worker_numba == {os.environ["NUMBA_CACHE_DIR"]}
+    ds = outcome.dataset
+    assert ds.attrs["fmu_sha256"] and ds.attrs["transient"] == 500.0 and ds.attrs["phi_threshold"] == 10.0
+    for point in points_of(grid, base):
+        direct = run_point(point.settings).as_dict()
+        at = ds.isel(dict(zip(grid.names, point.index)))
+        for name in MEASURED:
+            value = at[name].item()
+            if isinstance(direct[name], float) and np.isnan(direct[name]):
+                assert np.isnan(value), name
+            else:
+                assert value == direct[name], name
+    # No slip within 3000 < t_stick at A = 0; far above A_c(0.9) = 0.25 the block slides.
+    assert list(ds.regime.sel(A=0.0).values) == ["stuck", "stuck"]
+    assert ds.regime.sel(A=3.5, omega=0.9).item() == "sliding" and not ds.stick_slip.sel(A=3.5, omega=0.9)
+
+
+def test_failing_points_are_reported_together_after_the_others_are_stored(fmu_a, tmp_path):
+    grid = Grid.parse(["k_n=1,-1,2"])
+    base = base_point(fmu_a, horizon=50.0, transient=10.0)
+    with pytest.raises(SweepError, match=r"(?s)1 point\(s\) failed.*'k_n': -1.0.*not admissible"):
+        run_sweep(grid, base, tmp_path / "store", Execution(scheduler=INLINE, progress=False))
+    assert len(list((tmp_path / "store" / "points").glob("*.json"))) == 2
