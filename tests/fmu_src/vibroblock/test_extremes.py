@@ -8,10 +8,12 @@ block at rest).  Bounds: implicit_contact 1e-4 (second order, exact contact flow
 worst case here, 1.6e-5, is the 89 degree corrugation with k_n = 1e8, and it falls 4x
 per halving of dt), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), adaptive 1e-4 (at
 its default rtol = 1e-8; the worst case, 3.4e-5, is gamma_n = 1e4: the quadratures ride along
-without error control, and the stiff dashpot's dissipation is where that shows).  On the
-paper's 87 degree corrugation with k_n = 1e8 adaptive stops with its step budget (the
-contact chatter on the steep flank costs > 2^24 steps in t = 100): a clear refusal; so does
-model C bouncing with k_n = 1e8 (as measured; models A and B finish).
+without error control, and the stiff dashpot's dissipation is where that shows).  With k_n = 1e8 at rest on the paper's
+87 degree corrugation adaptive finishes (B slides down the flank and bounces in the valley:
+~4.7e5 steps, residual 5e-9 of the scale; C rests: ~1.2e6 steps, almost all while the
+start's normal ringing, amplitude above atol, dies out; residual 6e-6).  Model C bouncing
+with k_n = 1e8 and the steeper corrugation with stiff contact stop with its step budget
+(> 2^24 steps in t = 100): a clear refusal (as measured; models A and B finish).
 """
 from __future__ import annotations
 
@@ -41,7 +43,7 @@ ALL_RUN = {"symplectic_euler": None, "rk4": None, "implicit_contact": None}
 MATRIX = {
     # (every case below also runs adaptive, at its default tolerances; see ``matrix_cases``)
     "k_n/m = 1e8, at rest": ("A", {"k_n": 1e8}, EXPLICIT_REFUSE),
-    "k_n/m = 1e8, at rest, corrugated": ("BC", {"k_n": 1e8}, {**EXPLICIT_REFUSE, "adaptive": BUDGET}),
+    "k_n/m = 1e8, at rest, corrugated": ("BC", {"k_n": 1e8}, EXPLICIT_REFUSE),
     "k_n/m = 1e8, bouncing (A omega^2 = 2 g)": ("ABC", {"k_n": 1e8, "A": 2.0, "omega": 1.0},
                                                  {**EXPLICIT_REFUSE, "adaptive": {"C": BUDGET}}),
     "gamma_n = 0": ("ABC", {"gamma_n": 0.0, "A": 0.3, "omega": 1.2}, ALL_RUN),
