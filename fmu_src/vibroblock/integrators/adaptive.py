@@ -253,11 +253,14 @@ def _factor(jac, c, lu, piv):
 @njit(inline="always")
 def _solve(jac, c, lu, piv, r):
     """Solve (c I - J) k = r in place; the quadrature rows follow from the state's
-    (their columns of J are zero)."""
+    (their columns of J are zero).  ``_factor`` swaps whole rows, multipliers included,
+    so r takes all the interchanges before the forward substitution (interleaving them
+    would pair a row's value with another row's multipliers after a later swap)."""
     for k in range(NS):
         p = piv[k]
         if p != k:
             r[k], r[p] = r[p], r[k]
+    for k in range(NS):
         for i in range(k + 1, NS):
             r[i] -= lu[i, k] * r[k]
     for k in range(NS - 1, -1, -1):

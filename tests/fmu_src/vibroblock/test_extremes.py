@@ -8,10 +8,12 @@ block at rest).  Bounds: implicit_contact 1e-4 (second order, exact contact flow
 worst case here, 1.6e-5, is the 89 degree corrugation with k_n = 1e8, and it falls 4x
 per halving of dt), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), adaptive 1e-4 (at
 its default rtol = 1e-8; the worst case, 3.4e-5, is gamma_n = 1e4: the quadratures ride along
-without error control, and the stiff dashpot's dissipation is where that shows).  On the
-paper's 87 degree corrugation with k_n = 1e8 adaptive stops with its step budget (the
-contact chatter on the steep flank costs > 2^24 steps in t = 100): a clear refusal; so does
-model C bouncing with k_n = 1e8 (as measured; models A and B finish).
+without error control, and the stiff dashpot's dissipation is where that shows).  With k_n = 1e8 at rest on the paper's
+87 degree corrugation adaptive finishes (B slides down the flank and bounces in the valley:
+~4.7e5 steps, residual 5e-9 of the scale; C rests: ~1.2e6 steps, almost all while the
+start's normal ringing, amplitude above atol, dies out; residual 6e-6).  Model C bouncing
+with k_n = 1e8 and the steeper corrugation with stiff contact finish too (~3.7e6 and
+~4.2e6 steps, residuals ~1e-10 of the scale), within the step budget of 2^24 per call.
 """
 from __future__ import annotations
 
@@ -32,7 +34,6 @@ BOUND = {"symplectic_euler": 2e-2, "rk4": 1e-6, "implicit_contact": 1e-4, "adapt
 HORIZON = 100.0
 
 REFUSED_STEP = r"too large for the .* use dt <="  # an explicit scheme's stability limit, with the admissible dt
-BUDGET = r"more than \d+ internal steps between"  # adaptive's per-call step budget
 TOO_FAST = r"crosses the corrugation too fast for dt"
 
 # case -> (models, parameters, {integrator: expected error or None})
@@ -41,9 +42,9 @@ ALL_RUN = {"symplectic_euler": None, "rk4": None, "implicit_contact": None}
 MATRIX = {
     # (every case below also runs adaptive, at its default tolerances; see ``matrix_cases``)
     "k_n/m = 1e8, at rest": ("A", {"k_n": 1e8}, EXPLICIT_REFUSE),
-    "k_n/m = 1e8, at rest, corrugated": ("BC", {"k_n": 1e8}, {**EXPLICIT_REFUSE, "adaptive": BUDGET}),
+    "k_n/m = 1e8, at rest, corrugated": ("BC", {"k_n": 1e8}, EXPLICIT_REFUSE),
     "k_n/m = 1e8, bouncing (A omega^2 = 2 g)": ("ABC", {"k_n": 1e8, "A": 2.0, "omega": 1.0},
-                                                 {**EXPLICIT_REFUSE, "adaptive": {"C": BUDGET}}),
+                                                 EXPLICIT_REFUSE),
     "gamma_n = 0": ("ABC", {"gamma_n": 0.0, "A": 0.3, "omega": 1.2}, ALL_RUN),
     "gamma_n = 1e4": ("ABC", {"gamma_n": 1e4, "A": 0.3, "omega": 1.2}, EXPLICIT_REFUSE),
     "gamma_t = 0": ("ABC", {"gamma_t": 0.0, "A": 0.3, "omega": 1.2}, ALL_RUN),
@@ -53,7 +54,7 @@ MATRIX = {
     "omega = 1e3, A omega^2 = 0.1 g": ("ABC", {"A": 1e-7, "omega": 1e3}, ALL_RUN),
     "steep corrugation A_x omega_x = 20 (paper), vibrated": ("BC", {"A": 2.0, "omega": 1.0}, ALL_RUN),
     "steeper corrugation A_x omega_x = 50, stiff contact": ("BC", {"A_x": 2500.0, "k_n": 1e8, "A": 2.0, "omega": 1.0},
-                                                             {**EXPLICIT_REFUSE, "adaptive": {"C": BUDGET}}),
+                                                             EXPLICIT_REFUSE),
     "V_d = 1e-12": ("ABC", {"V_d": 1e-12}, ALL_RUN),
     "V_d = 1e3, flat": ("A", {"V_d": 1e3}, ALL_RUN),
     "V_d = 1e3, corrugated": ("BC", {"V_d": 1e3}, {**ALL_RUN, "implicit_contact": TOO_FAST}),
