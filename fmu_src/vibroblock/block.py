@@ -86,6 +86,7 @@ class Block:
             self.frozen_released = False  # stays frozen: the next call meets the guard, and this error, again
             raise ModelError(f"the frozen_vertical guard handed over to the full model at t = {self.time:g} (the "
                              f"block would detach), which cannot run at this dt: {exc}") from None
+        self._bind_kernels()
 
     # ------------------------------------------------------------------ running
     def start(self, t0: float = 0.0) -> None:
@@ -105,6 +106,7 @@ class Block:
         self.y = np.zeros(L.N_Y)
         self.obs = np.zeros(L.N_OBS)
         self.time = t0
+        self._bind_kernels()
         if not place(self.settings, self.prm, self.drv, self.y):
             self._release_frozen_vertical()
         self.started = True
@@ -135,35 +137,47 @@ class Block:
         self.drv[L.D_EXT_T] = self.time
         self._observed = None
 
+    def _bind_kernels(self) -> None:
+        """Resolve what a call runs once, not per call: the integrator that runs now, its
+        compiled kernels bound to this run's arrays, the grid and the step budget.  They
+        change only when the arrays are made (start, set_state) or the frozen_vertical
+        guard hands over; the settings that select them are fixed once a run has started."""
+        settings, released = self.settings, self.frozen_released
+        kernel = settings.kernel(released)
+        arrays = (settings.kind, settings.scene_flags(released), self.y, self.cnt, self.drv, self.prm)
+        self._kernel = kernel
+        self._advance = kernel.bind_advance(*arrays)
+        self._observe_at = kernel.bind_observe(*arrays)
+        self._track_energy = settings.energy_balance
+        self._grid = (float(self.drv[L.D_T0]), float(self.drv[L.D_DT]))
+        self._step_budget = STEP_BUDGET_PER_CALL if kernel.force_evaluations > 0 else math.inf
+
     def advance_to(self, t_end: float) -> None:
         """Advance to t_end > current time; on failure the state is left unchanged."""
         self._require_started()
         if not (math.isfinite(t_end) and t_end > self.time):
             raise ModelError(f"cannot advance from t = {self.time!r} to t = {t_end!r}: "
                              "the end time must be finite and later than the current time")
-        dt, t0 = self.drv[L.D_DT], self.drv[L.D_T0]
+        t0, dt = self._grid
         # Grid point at or just below t_end.  The tolerance absorbs masters that
         # accumulate time (t += h drifts by ~1e-10 over thousands of steps).
         target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
-        todo = target - int(self.cnt[L.C_STEP])
-        kernel = self.settings.kernel(self.frozen_released)
-        if todo > STEP_BUDGET_PER_CALL and kernel.force_evaluations > 0:
+        step = self.cnt.item(L.C_STEP)
+        if target - step > self._step_budget:
+            todo = target - step
             raise ModelError(
                 f"advancing from t = {self.time:g} to t = {t_end:g} takes {todo:.3g} internal steps of dt = {dt:g} "
                 f"with {self.integrator} (hours: ~{todo / 1e8 / 3600:.2g} h or more at 1e8 steps/s); one call may take "
                 f"at most {STEP_BUDGET_PER_CALL:.3g} steps so that a master is never held. Use shorter communication "
                 "steps, or a larger dt with implicit_contact (no contact stiffness limit), or event_driven (model A); "
                 "the state is kept.")
-        while todo > 0:
-            kernel = self.settings.kernel(self.frozen_released)
-            before = int(self.cnt[L.C_STEP])
-            status = kernel.run_advance(self.settings.kind, self.settings.scene_flags(self.frozen_released),
-                                        self.y, self.cnt, self.drv, self.prm, todo, self.energy_balance)
+        while step < target:
+            status = self._advance(target - step, self._track_energy)
             if status < 0:
-                raise ModelError(kernel.message(status, t=self.time, t_end=t_end, dt=dt))
-            todo -= int(self.cnt[L.C_STEP]) - before
+                raise ModelError(self._kernel.message(status, t=self.time, t_end=t_end, dt=dt))
+            step = self.cnt.item(L.C_STEP)
             if status > 0:  # a scene's guard stopped it: the frozen vertical motion hands over
-                self.time = float(t0 + self.cnt[L.C_STEP] * dt)
+                self.time = float(t0 + step * dt)
                 self._observed = None
                 self._release_frozen_vertical()
         self.time = float(t_end)
@@ -192,14 +206,12 @@ class Block:
 
     def _observe(self):
         """The observation array (``layout.O_*``) at the current time."""
-        dt = self.drv[L.D_DT]
-        grid_time = self.drv[L.D_T0] + self.cnt[L.C_STEP] * dt
+        t0, dt = self._grid
+        grid_time = t0 + self.cnt.item(L.C_STEP) * dt
         h = self.time - grid_time
         if h < GRID_TOLERANCE * dt:  # on the grid up to rounding of the master's time
             h = 0.0
-        kernel = self.settings.kernel(self.frozen_released)
-        kernel.run_observe(self.settings.kind, self.settings.scene_flags(self.frozen_released),
-                           self.y, self.cnt, self.drv, self.prm, min(h, dt), self.energy_balance, self.obs)
+        self._observe_at(min(h, dt), self._track_energy, self.obs)
         return self.obs
 
     def _stored_energy(self, obs, e_normal, t):
@@ -281,5 +293,6 @@ class Block:
         self.obs = np.zeros(L.N_OBS)
         self.frozen_released = bool(state.get("frozen_released", False))
         self.time = float(state["time"])
+        self._bind_kernels()
         self.started = True
         self._observed = None

@@ -135,7 +135,8 @@ class BlockFacade(FmuFacade):
         self._apply_input()
 
     def _advance_to(self, end_time: float) -> None:
-        self._apply_input()
+        if self._input_changed:
+            self._apply_input()
         self.block.advance_to(end_time)
 
     def _capture(self) -> dict:

@@ -37,7 +37,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable
+
+import numpy as np
 
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import typeof, types  # noqa: E402
@@ -133,10 +136,23 @@ class Integrator:
     unsupported_reading: Callable[[dict], str | None] = lambda readings: None
 
     def run_advance(self, kind: int, flags: int, y, cnt, drv, prm, n_steps: int, track_energy: bool) -> int:
-        return _specialized(self.advance, kind, self.id, (flags, y, cnt, drv, prm, n_steps, bool(track_energy)))
+        return self.bind_advance(kind, flags, y, cnt, drv, prm)(n_steps, bool(track_energy))
 
     def run_observe(self, kind: int, flags: int, y, cnt, drv, prm, h: float, track_energy: bool, obs) -> None:
-        _specialized(self.observe, kind, self.id, (flags, y, cnt, drv, prm, float(h), bool(track_energy), obs))
+        self.bind_observe(kind, flags, y, cnt, drv, prm)(float(h), bool(track_energy), obs)
+
+    def bind_advance(self, kind: int, flags: int, y, cnt, drv, prm) -> Callable:
+        """The advance kernel's compiled entry point with the run's arrays bound:
+        ``(n_steps, track_energy) -> status``.  Resolved once, it is called without any
+        lookup or type resolution (a doStep's overhead, harness/benchmarks/fmi_boundary.py)."""
+        args = (flags, y, cnt, drv, prm)
+        return partial(_entry_point(self.advance, kind, self.id, (*args, 0, False)), kind, self.id, *args)
+
+    def bind_observe(self, kind: int, flags: int, y, cnt, drv, prm) -> Callable:
+        """The observe kernel bound likewise: ``(h, track_energy, obs)``."""
+        args = (flags, y, cnt, drv, prm)
+        return partial(_entry_point(self.observe, kind, self.id, (*args, 0.0, False, np.zeros(0))), kind, self.id,
+                       *args)
 
     def supports(self, model: str) -> bool:
         return self.models == "*" or model in self.models
@@ -154,14 +170,15 @@ class Integrator:
 _ENTRY_POINTS: dict = {}
 
 
-def _specialized(kernel, kind: int, method: int, args: tuple):
+def _entry_point(kernel, kind: int, method: int, args: tuple):
+    """The compiled entry point of ``kernel`` for (kind, method) and arguments typed like ``args``."""
     key = (kernel, kind, method)
     entry = _ENTRY_POINTS.get(key)
     if entry is None:
         signature = (types.literal(kind), types.literal(method), *(typeof(a) for a in args))
         kernel.compile(signature)
         entry = _ENTRY_POINTS[key] = kernel.overloads[signature].entry_point
-    return entry(kind, method, *args)
+    return entry
 
 
 def _fixed_step(id, name, module, **record):
