@@ -5,6 +5,8 @@ Each change between neighbours brackets a transition; :func:`locate_transitions`
 halves every bracket (in log scale for positive values, the geometric mean, since the
 grids are geometric) until ``hi / lo - 1 <= resolution``, classifying the midpoints of all
 open brackets of one round in a single batch so that they run in parallel.
+:func:`refine` does the same for brackets gathered elsewhere (several columns of a phase
+diagram at once, each transition carrying where it lies in ``where``).
 
 Bisection finds *a* change of class inside each bracket.  Where the class flips more
 than once between two grid values (near-marginal or chaotic points), the located value
@@ -27,6 +29,7 @@ class Transition:
     hi: float
     held_lo: bool
     evaluations: list[tuple[float, bool]] = field(default_factory=list)  # bisection points, in order
+    where: dict = field(default_factory=dict)  # the other coordinates of the bracket, if any
 
     @property
     def kind(self) -> str:
@@ -70,15 +73,23 @@ def locate_transitions(classify: Callable[[list[float]], list[bool]], values: Se
 
     ``classify(points)`` returns, for a batch of parameter values, whether each is held by
     friction; it is called once per round with the midpoints of all open brackets."""
+    return refine(lambda pairs: classify([point for _, point in pairs]), brackets(values, held), resolution,
+                  max_rounds)
+
+
+def refine(classify: Callable[[list[tuple[Transition, float]]], list[bool]], found: list[Transition],
+           resolution: float = 0.03, max_rounds: int = 20) -> list[Transition]:
+    """Bisect the given brackets in place to ``resolution``; ``classify`` gets, once per
+    round, (transition, midpoint) for every open bracket and returns whether each midpoint
+    is held.  Returns ``found``."""
     if not resolution > 0:
         raise ValueError(f"resolution = {resolution!r} must be > 0")
-    found = brackets(values, held)
     for _ in range(max_rounds):
         open_ = [t for t in found if t.resolution > resolution]
         if not open_:
             break
         midpoints = [_midpoint(t.lo, t.hi) for t in open_]
-        classes = classify(midpoints)
+        classes = classify(list(zip(open_, midpoints)))
         if len(classes) != len(midpoints):
             raise ValueError(f"classify returned {len(classes)} classes for {len(midpoints)} points")
         for transition, point, held_mid in zip(open_, midpoints, classes):
@@ -90,4 +101,4 @@ def locate_transitions(classify: Callable[[list[float]], list[bool]], values: Se
     return found
 
 
-__all__ = ["LOSS", "RECOVERY", "Transition", "brackets", "locate_transitions"]
+__all__ = ["LOSS", "RECOVERY", "Transition", "brackets", "locate_transitions", "refine"]

@@ -1,8 +1,12 @@
 """C3 -- model A's A-omega phase diagram (Fig. 1c): the onset of sliding.
 
-Criteria: C3a: every column with omega <= ``LOW_OMEGA`` has its friction/sliding boundary
-between the same two grid amplitudes as A = g/omega^2, and no column changes regime more
-than once along A.  C3b: the same bracket test for A_c(omega) on every column."""
+The grid brackets each column's friction/sliding boundary; each bracket is then bisected
+in A (:mod:`harness.runs.bisection`) to ``BOUNDARY_RESOLUTION``, all columns together.
+
+Criteria: C3a: every column with omega <= ``LOW_OMEGA`` has its located boundary within
+``FORMULA_TOLERANCE`` of A = g/omega^2 (within the grid bracket where nothing was
+located), and no column changes regime more than once along A.  C3b: the same test for
+A_c(omega) on every column."""
 from __future__ import annotations
 
 from typing import Sequence
@@ -10,14 +14,17 @@ from typing import Sequence
 import numpy as np
 
 from harness.paper.plots import regime_scatter
+from harness.runs.bisection import Transition, refine
 from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
 
-from .measure import OBSERVE_A, SCALED, observe_json, onset_amplitude, regime_changes, transition_bracket
+from .measure import (OBSERVE_A, SCALED, friction_held, observe_json, onset_amplitude, regime_changes,
+                      run_and_measure, transition_bracket)
 from .study import Claim, Runner, Study
-from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, Row, combine, fmt
+from .verdicts import AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, Row, combine, fmt
 
 LOW_OMEGA = 0.3
+BOUNDARY_RESOLUTION = 0.03  # relative width in A of a located boundary
 
 TEXT = {
     "C3a": "A: stick-slip -> sliding at A omega^2 = g (omega << omega_n), the only transition in A",
@@ -30,6 +37,10 @@ FIGURES = {
 
 
 def _bracketed(column: dict, line: float, amplitudes: Sequence[float]) -> bool:
+    """The line agrees with the column's boundary: within FORMULA_TOLERANCE of the located
+    boundary, or (nothing located) between the grid amplitudes that bracket it."""
+    if column.get("located_A") is not None:
+        return abs(column["located_A"] / line - 1.0) <= FORMULA_TOLERANCE
     low, high = column["last_friction_A"], column["first_sliding_A"]
     if high is None:
         return line > max(amplitudes)
@@ -49,13 +60,33 @@ def study_c3(runner: Runner) -> Study:
         columns.append({"omega": float(omega), "regimes": regimes, "last_friction_A": last_held,
                         "first_sliding_A": first_slide, "changes": regime_changes(regimes),
                         "paper_line": 1.0 / float(omega) ** 2, "onset_curve": float(onset_amplitude(omega))})
-    measured = {"columns": columns, "amplitudes": ds.A.values.tolist()}
+    _locate_boundaries(runner, base, columns)
+    measured = {"columns": columns, "amplitudes": ds.A.values.tolist(), "resolution": BOUNDARY_RESOLUTION}
     settings = {"model": "A", "parameters": "scaled", "horizon": res.horizon_a, "initial": "steady orbit",
                 **observe_json(OBSERVE_A)}
     data = {"omega": ds.omega.values.tolist(), "A": ds.A.values.tolist(),
             "regime": ds.regime.transpose("A", "omega").values.tolist(),
             "phi": ds.phi.transpose("A", "omega").values.tolist()}
     return Study("C3", measured, settings, data)
+
+
+def _locate_boundaries(runner: Runner, base: PointSettings, columns: list[dict]) -> None:
+    """Bisect each column's grid bracket (last held A, first sliding A) in A, all columns
+    per round in one batch; adds located_A and its bracket to the columns."""
+    found = [Transition(c["last_friction_A"], c["first_sliding_A"], True, where={"omega": c["omega"]})
+             for c in columns if c["last_friction_A"] is not None and c["first_sliding_A"] is not None]
+
+    def classify(pairs):
+        items = [{"point": PointSettings(run=base.run.with_parameters({"A": a, "omega": t.where["omega"]}),
+                                         observe=base.observe)} for t, a in pairs]
+        return [friction_held(r["observables"]["regime"]) for r in runner.tasks(run_and_measure, items)]
+
+    refine(classify, found, BOUNDARY_RESOLUTION)
+    located = {t.where["omega"]: t for t in found}
+    for column in columns:
+        t = located.get(column["omega"])
+        column.update({"located_A": t.value if t else None, "located_lo": t.lo if t else None,
+                       "located_hi": t.hi if t else None})
 
 
 def verdict_c3(m: dict) -> tuple[Row, Row]:
@@ -65,25 +96,26 @@ def verdict_c3(m: dict) -> tuple[Row, Row]:
     single = [c for c in columns if c["changes"] <= 1]
     paper_all = [c for c in columns if _bracketed(c, c["paper_line"], amplitudes)]
     onset_ok = [c for c in columns if _bracketed(c, c["onset_curve"], amplitudes)]
-    boundaries = "; ".join(f"w = {c['omega']:.3g}: [{fmt(c['last_friction_A'])}, {fmt(c['first_sliding_A'])}] "
-                           f"(g/w^2 = {c['paper_line']:.3g}, A_c = {c['onset_curve']:.3g})" for c in columns)
-    measured_a = (f"friction/sliding boundary brackets g/w^2 in {len(paper_ok)}/{len(low)} columns with "
+    boundaries = "; ".join(f"w = {c['omega']:.3g}: grid [{fmt(c['last_friction_A'])}, {fmt(c['first_sliding_A'])}], "
+                           f"located {fmt(c.get('located_A'))} (g/w^2 = {c['paper_line']:.3g}, "
+                           f"A_c = {c['onset_curve']:.3g})" for c in columns)
+    measured_a = (f"friction/sliding boundary at g/w^2 (within {FORMULA_TOLERANCE:.0%}) in {len(paper_ok)}/{len(low)} columns with "
                   f"w <= {LOW_OMEGA:g} ({len(paper_all)}/{len(columns)} over all w); single transition in "
                   f"{len(single)}/{len(columns)} columns. Boundaries: {boundaries}")
     if not low:
         row_a = Row("C3a", measured_a, NOT_REPRODUCED, f"no column with omega <= {LOW_OMEGA:g}")
     else:
         parts = [(AGREES if len(paper_ok) == len(low) else DISAGREES,
-                  f"g/w^2 bracketed in {len(paper_ok)}/{len(low)} low-w columns"),
+                  f"g/w^2 at the boundary in {len(paper_ok)}/{len(low)} low-w columns"),
                  (AGREES if len(single) == len(columns) else DISAGREES,
                   f"{len(columns) - len(single)} column(s) with more than one transition in A")]
         verdict, reason = combine(parts)
         row_a = Row("C3a", measured_a, verdict, reason)
-    measured_b = (f"A_c(w) bracketed in {len(onset_ok)}/{len(columns)} columns, g/w^2 in "
-                  f"{len(paper_all)}/{len(columns)}")
+    measured_b = (f"A_c(w) at the boundary in {len(onset_ok)}/{len(columns)} columns, g/w^2 in "
+                  f"{len(paper_all)}/{len(columns)}. Boundaries: {boundaries}")
     verdict = AGREES if len(onset_ok) == len(columns) else DISAGREES
-    reason = (f"A_c(w) lies between the last friction and first sliding amplitude in "
-              f"{len(onset_ok)}/{len(columns)} columns")
+    reason = (f"A_c(w) within {FORMULA_TOLERANCE:.0%} of the boundary located to "
+              f"{m.get('resolution', 0):.0%} in A (or inside the grid bracket) in {len(onset_ok)}/{len(columns)} columns")
     return row_a, Row("C3b", measured_b, verdict, reason)
 
 
@@ -98,6 +130,9 @@ def draw(study: Study, save) -> None:
     line = np.geomspace(min(d["omega"]), max(d["omega"]), 300)
     ax.plot(line, 1 / line**2, "k:", label=r"$A = g/\omega^2$")
     ax.plot(line, onset_amplitude(line), "k-", lw=1, label=r"$A_c(\omega)$")
+    located = [(c["omega"], c["located_A"]) for c in study.measured["columns"] if c.get("located_A") is not None]
+    if located:
+        ax.plot(*zip(*located), "D", color="k", mfc="none", label="boundary (bisected)")
     ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A", title="Model A (scaled drive)")
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
     ax.legend(fontsize="small")

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from harness.runs.bisection import LOSS, RECOVERY, brackets, locate_transitions
+from harness.runs.bisection import LOSS, RECOVERY, Transition, brackets, locate_transitions, refine
 
 LOSS_AT, RECOVERY_AT = 1.37, 12.5  # a classifier held below 1.37 and above 12.5
 
@@ -52,3 +52,20 @@ def test_brackets_through_zero_halve_linearly():
 def test_bad_grids_are_refused(values, classes, message):
     with pytest.raises(ValueError, match=message):
         brackets(values, classes)
+
+
+def test_brackets_of_several_columns_are_refined_together():
+    # Two columns of a phase diagram, each with its own boundary in A: one batch per round.
+    truth = {0.5: 4.0, 2.0: 0.25}
+    found = [Transition(1.0, 10.0, True, where={"omega": 0.5}), Transition(0.1, 1.0, True, where={"omega": 2.0})]
+    batches = []
+
+    def classify(pairs):
+        batches.append(len(pairs))
+        return [point < truth[t.where["omega"]] for t, point in pairs]
+
+    refine(classify, found, resolution=0.01)
+    for transition in found:
+        assert transition.lo < truth[transition.where["omega"]] <= transition.hi
+        assert transition.resolution <= 0.01
+    assert set(batches) == {2}

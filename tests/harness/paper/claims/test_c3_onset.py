@@ -21,3 +21,13 @@ def test_c3_bracket_tests():
     row_a, row_b = verdict_c3(bad)
     assert row_a.verdict == DISAGREES and "1 column(s) with more than one transition" in row_a.reason
     assert row_b.verdict == DISAGREES
+
+
+def test_a_located_boundary_is_judged_within_the_formula_tolerance():
+    amplitudes = [0.1, 1.0, 10.0, 100.0, 1000.0]
+    near = {**c3_column(0.1, 10.0, 1000.0), "located_A": 95.0}    # g/w^2 = 100, A_c ~ 99: 5 % off
+    far = {**c3_column(0.1, 10.0, 1000.0), "located_A": 80.0}     # 20 % off, though inside the grid bracket
+    row_a, row_b = verdict_c3({"amplitudes": amplitudes, "columns": [near], "resolution": 0.03})
+    assert row_a.verdict == AGREES and row_b.verdict == AGREES
+    row_a, row_b = verdict_c3({"amplitudes": amplitudes, "columns": [far], "resolution": 0.03})
+    assert row_a.verdict == DISAGREES and row_b.verdict == DISAGREES
