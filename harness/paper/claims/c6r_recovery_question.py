@@ -166,7 +166,7 @@ def _closest(value: float, candidates: list[float]) -> float | None:
 
 
 def _row(runner: Runner, configuration: Configuration, amplitude: float, omegas, k_n: float = K_N) -> dict:
-    gamma_n = k_n / (K_N / GAMMA_N)
+    gamma_n = k_n * GAMMA_N / K_N  # k_n / gamma_n kept at the paper's 14.3
     base = PointSettings(run=_run(runner, configuration, amplitude, k_n=k_n, gamma_n=gamma_n),
                          observe=configuration.observe)
     ds = runner.sweep(Grid((Axis("omega", omegas),)), base)
