@@ -35,6 +35,12 @@ Definitions
   last sample before it to the first sample after it).
 * coulomb_resets: increase of the FMU's ``slip_count`` over the window, for
   information only (it depends on dt and counts the cascades before a detachment).
+* slope angles (corrugated plates, attributes ``A_x`` and ``omega_x``): the local slope
+  alpha = arctan(A_x omega_x cos(omega_x x)) of the surface under the block, in degrees,
+  positive where it rises along +x (the drive's direction): at the window's last sample
+  (where a jammed block sits) and the median over the window's samples at rest
+  (|vx| < V_d / 10: the stick sites).  Self-locking needs alpha >= arctan(1 / mu_s).
+  NaN on a flat plate, or with no sample at rest.
 """
 from __future__ import annotations
 
@@ -127,6 +133,18 @@ def refine(regime: str, ds: xr.Dataset, win: Window, contact: float) -> str:
     stretch_end = v_d * time[win.last] - x[win.last]
     growing = abs(stretch_end) > abs(stretch_start)
     return JAMMED if growing and abs(stretch_end) > nominal_slip_length(ds.attrs) else STUCK
+
+
+def slope_angles(ds: xr.Dataset, win: Window) -> tuple[float, float]:
+    """(alpha at the window's last sample, median alpha at rest in the window), degrees."""
+    a_x, omega_x = float(ds.attrs.get("A_x", 0.0)), float(ds.attrs.get("omega_x", 0.0))
+    if a_x == 0.0 or omega_x == 0.0:
+        return math.nan, math.nan
+    part = win.slice()
+    x, vx = ds["x"].values[part], ds["vx"].values[part]
+    alpha = np.degrees(np.arctan(a_x * omega_x * np.cos(omega_x * x)))
+    at_rest = np.abs(vx) < 0.1 * abs(drive_velocity(ds))
+    return float(alpha[-1]), float(np.median(alpha[at_rest])) if at_rest.any() else math.nan
 
 
 def drift_velocity(ds: xr.Dataset, win: Window) -> float:
@@ -252,6 +270,8 @@ class Observables:
     contact_fraction: float
     drift_velocity: float
     coulomb_resets: int
+    slope_angle_end: float      # degrees, corrugated plates only (see the module doc)
+    slope_angle_at_rest: float  # degrees, median over the samples at rest
     window_start: float
     window_end: float
     transient: float
@@ -268,7 +288,7 @@ class Observables:
 # Observables that vary from point to point (the rest are settings, reported as attributes).
 MEASURED = ("phi", "regime", "slip_events", "stick_time_mean", "stick_time_std", "slip_interval_mean",
             "slip_length_mean", "slip_length_std", "contact_fraction", "drift_velocity", "coulomb_resets",
-            "window_start", "window_end")
+            "slope_angle_end", "slope_angle_at_rest", "window_start", "window_end")
 
 
 def observe(ds: xr.Dataset, settings: ObservableSettings = ObservableSettings()) -> Observables:
@@ -279,11 +299,13 @@ def observe(ds: xr.Dataset, settings: ObservableSettings = ObservableSettings())
     slips = window_slips(ds, win, settings)
     contact = contact_fraction(ds, win)
     regime = refine(classify(value, settings.phi_threshold, drift, drive_velocity(ds)), ds, win, contact)
+    angle_end, angle_at_rest = slope_angles(ds, win)
     return Observables(
         phi=value, regime=regime, slip_events=slips.count,
         stick_time_mean=_mean(slips.stick_times), stick_time_std=_std(slips.stick_times),
         slip_interval_mean=_mean(slips.intervals),
         slip_length_mean=_mean(slips.length), slip_length_std=_std(slips.length),
         contact_fraction=contact, drift_velocity=drift,
-        coulomb_resets=coulomb_resets(ds, win), window_start=win.start, window_end=win.end,
+        coulomb_resets=coulomb_resets(ds, win), slope_angle_end=angle_end, slope_angle_at_rest=angle_at_rest,
+        window_start=win.start, window_end=win.end,
         transient=settings.transient, phi_threshold=settings.phi_threshold)

@@ -181,6 +181,7 @@ def _row(runner: Runner, configuration: Configuration, amplitude: float, omegas,
     return {"configuration": configuration.label, "A": amplitude, "k_n": k_n, "gamma_n": gamma_n,
             "omegas": list(omegas), "regimes": regimes,
             "contact_fraction": ds.contact_fraction.values.tolist(), "phi": ds.phi.values.tolist(),
+            "slope_angle_end": ds.slope_angle_end.values.tolist(),
             "transitions": transitions, "omega_1": omega_1, "omega_2": omega_2,
             "omega_2_resolution": recoveries[0]["resolution"] if recoveries else None,
             "loss_above_omega_2": next((t["value"] for t in losses if omega_2 and t["value"] > omega_2), None),
@@ -262,11 +263,16 @@ def verdict_rows(m: dict) -> list:
     for row in m["rows"]:
         by_configuration.setdefault(row["configuration"], []).append(row)
 
+    def jams(r):
+        angles = [a for a, regime in zip(r.get("slope_angle_end", []), r["regimes"]) if regime == "jammed"]
+        return (f"; jammed at {len(angles)}/{len(r['regimes'])} grid omegas, on slopes of {min(angles):.0f} to "
+                f"{max(angles):.0f} deg") if angles else ""
+
     def located(r):
         return (f"{r['configuration']}, A = {r['A']:g}: friction lost at {fmt(r['omega_1'])}, back at "
                 f"{fmt(r['omega_2'])}, lost again at {fmt(r['loss_above_omega_2'])} (A_N roots "
                 + ", ".join(f"{w:.3g}" for w in r["A_N_roots"]) + "; A_c roots "
-                + ", ".join(f"{w:.3g}" for w in r["A_c_roots"]) + ")")
+                + ", ".join(f"{w:.3g}" for w in r["A_c_roots"]) + ")" + jams(r))
 
     measured = "; ".join(located(r) for r in m["rows"])
     flat = [r for r in m["rows"] if r["configuration"].startswith("A,")]

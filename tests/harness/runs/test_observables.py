@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 from harness.runs.observables import (FLYING, JAMMED, SLIDING, STICK_SLIP, STUCK, classify, contact_fraction,
-                                      drift_velocity, observe, phi, slip_events, window)
+                                      drift_velocity, observe, phi, slip_events, slope_angles, window)
 from harness.runs.settings import ObservableSettings
 
 V_D = 0.01
@@ -164,3 +164,19 @@ def test_a_window_without_two_samples_is_refused():
     ds = dataset(t, np.zeros_like(t))
     with pytest.raises(ValueError, match="fewer than two samples"):
         window(ds, transient=9.5)
+
+
+def test_slope_angles_at_the_stick_sites_of_a_corrugated_plate():
+    # Stuck at x = 10 on the paper's corrugation (A_x omega_x = 20) for the first half,
+    # then sliding at 2 V_d: the stick site's slope is arctan(20 cos(0.2)) = 87.1 degrees.
+    t = np.arange(0.0, 2000.0, 1.0)
+    vx = np.where(t < 1000.0, 0.0, 2 * V_D)
+    ds = dataset(t, vx, A_x=1e3, omega_x=2e-2)
+    ds["x"] = ds["x"] + 10.0
+    win = window(ds, 0.0)
+    end, at_rest = slope_angles(ds, win)
+    assert at_rest == pytest.approx(math.degrees(math.atan(20.0 * math.cos(0.2))), rel=1e-12)
+    x_end = float(ds["x"].values[-1])
+    assert end == pytest.approx(math.degrees(math.atan(20.0 * math.cos(0.02 * x_end))), rel=1e-12)
+    flat = dataset(t, vx)
+    assert all(math.isnan(a) for a in slope_angles(flat, window(flat, 0.0)))
