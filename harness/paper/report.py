@@ -10,26 +10,95 @@ import os
 from pathlib import Path
 from typing import Sequence
 
-from .claims import CLAIMS, Study
-from .claims.verdicts import AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row
+from .claims import CLAIMS, DEFAULT_READING, READINGS, Study, study_name
+from .claims.verdicts import AGREES, DISAGREES, FLIPS, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row
 
 CLAIM_TEXT = {part: text for claim in CLAIMS.values() for part, text in claim.text.items()}
 FIGURES = {part: files for claim in CLAIMS.values() for part, files in claim.figures.items()}
 
 
+def _rows(name: str, study: Study) -> list[Row]:
+    made = CLAIMS[name].verdicts(study.measured)
+    made = [made] if isinstance(made, Row) else list(made)
+    for row in made:
+        row.figures = FIGURES.get(row.claim, [])
+        row.settings = _settings_text(study.settings)
+    return made
+
+
+def reading_rows(studies: dict[str, Study]) -> dict[str, dict]:
+    """{claim part: {reading: Row}} for every claim measured under more than one reading
+    (the readings in the claim's order, the default first)."""
+    table: dict[str, dict] = {}
+    for name, claim in CLAIMS.items():
+        present = [r for r in claim.readings if study_name(name, r) in studies]
+        if claim.verdicts is None or len(present) < 2:
+            continue
+        for reading in present:
+            for row in _rows(name, studies[study_name(name, reading)]):
+                table.setdefault(row.claim, {})[reading] = row
+    return table
+
+
 def claim_rows(studies: dict[str, Study]) -> list[Row]:
-    """Every row of the claims table, from the studies' measured values."""
+    """Every row of the claims table, from the studies' measured values under the default
+    reading; a part whose verdict differs under another reading gets the verdict FLIPS
+    and a reason that names the verdict of each reading."""
+    by_reading = reading_rows(studies)
     rows: list[Row] = []
     for name, claim in CLAIMS.items():
         if claim.verdicts is None or name not in studies:
             continue
-        made = claim.verdicts(studies[name].measured)
-        made = [made] if isinstance(made, Row) else list(made)
-        for row in made:
-            row.figures = FIGURES.get(row.claim, [])
-            row.settings = _settings_text(studies[name].settings)
-        rows.extend(made)
+        for row in _rows(name, studies[name]):
+            verdicts = {r: other.verdict for r, other in by_reading.get(row.claim, {}).items()}
+            if len(set(verdicts.values())) > 1:
+                row.reason = ("; ".join(f"{r.label}: {v}" for r, v in verdicts.items())
+                              + f". Under the default reading ({DEFAULT_READING.label}): {row.reason}")
+                row.verdict = FLIPS
+            rows.append(row)
     return rows
+
+
+def readings_markdown(studies: dict[str, Study]) -> list[str]:
+    """The section that sets the readings side by side: one row per claim part, one column
+    per reading, and per reading the parts on which it agrees with the paper."""
+    table = reading_rows(studies)
+    if not table:
+        return []
+    readings = _columns(table)
+    lines = ["## The readings side by side", "",
+             "Models B and C are integrated in fixed axes (Newton's law for the point) or in the tangent frame "
+             "(the paper's Eqs. 3-6 as printed); the Coulomb bound mu_s N takes N as the contact force or as the "
+             "applied load (docs/physics.md). The claims these readings can change were measured under each; "
+             "model A has no corrugation, so its parts differ only with the bound. Cells: verdict, then why.", "",
+             "| part | " + " | ".join(r.label for r in readings) + " |", "|---|" + "---|" * len(readings)]
+    for part, per_part in table.items():
+        cells = [f"**{per_part[r].verdict}**: {_cell(per_part[r].reason)}" if r in per_part else "n/a" for r in readings]
+        lines.append(f"| {part} | " + " | ".join(cells) + " |")
+    lines += [""] + [f"- {line}" for line in reading_summary(studies)] + [""]
+    return lines
+
+
+def _columns(table: dict) -> list:
+    """The readings present in a reading_rows table, in the order of READINGS."""
+    present = {r for per_part in table.values() for r in per_part}
+    return [r for r in READINGS if r in present]
+
+
+def reading_summary(studies: dict[str, Study]) -> list[str]:
+    """Per reading: the parts it agrees with the paper on, out of those measured under it;
+    then the parts whose verdict flips with the reading."""
+    table = reading_rows(studies)
+    readings = _columns(table)
+    lines = []
+    for reading in readings:
+        parts = [part for part, per_part in table.items() if reading in per_part]
+        agreeing = [part for part in parts if table[part][reading].verdict == AGREES]
+        lines.append(f"{reading.label}: agrees on {len(agreeing)} of {len(parts)} parts"
+                     + (f" ({', '.join(agreeing)})" if agreeing else ""))
+    flipping = [part for part, per_part in table.items() if len({row.verdict for row in per_part.values()}) > 1]
+    lines.append("verdict flips with the reading: " + (", ".join(flipping) if flipping else "none"))
+    return lines
 
 
 def _settings_text(settings: dict) -> str:
@@ -59,8 +128,11 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
         lines.append(f"| {row.claim} | {_cell(CLAIM_TEXT[row.claim])} | {_cell(row.measured)} | **{row.verdict}** | "
                      f"{_cell(row.reason)} | {figures} |")
         summary[row.verdict] = summary.get(row.verdict, 0) + 1
-    lines += ["", "Summary: " + ", ".join(f"{v}: {n}" for v, n in sorted(summary.items())), "",
-              "## Parameter sets and classification per study", "",
+    lines += ["", "Summary: " + ", ".join(f"{v}: {n}" for v, n in sorted(summary.items()))]
+    if reading_rows(studies):
+        lines += ["", "Readings (see \"The readings side by side\"):"] + [f"- {line}" for line in reading_summary(studies)]
+    lines += [""] + readings_markdown(studies)
+    lines += ["## Parameter sets and classification per study", "",
               "| study | settings |", "|---|---|"]
     for name, study in studies.items():
         lines.append(f"| {name} | {_cell(_settings_text(study.settings))}; merge gap {study.settings.get('merge_gap', 'n/a')}, "
@@ -94,7 +166,7 @@ def make_figures(studies: dict[str, Study], out: str | os.PathLike) -> list[str]
         written.append(name)
 
     for name, claim in CLAIMS.items():
-        if claim.draw is not None and name in studies:
+        if claim.draw is not None and name in studies:  # the figures show the default reading
             claim.draw(studies[name], save)
     return written
 
@@ -116,5 +188,5 @@ def write_report(studies: dict[str, Study], out: str | os.PathLike, extra_figure
     return path
 
 
-__all__ = ["AGREES", "CLAIM_TEXT", "DISAGREES", "FIGURES", "NOT_REPRODUCED", "Row", "claim_rows", "make_figures",
-           "markdown", "timing_lines", "write_report"]
+__all__ = ["AGREES", "CLAIM_TEXT", "DISAGREES", "FIGURES", "FLIPS", "NOT_REPRODUCED", "Row", "claim_rows",
+           "make_figures", "markdown", "reading_rows", "reading_summary", "timing_lines", "write_report"]

@@ -17,6 +17,7 @@ from typing import Sequence
 
 from . import (c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery,
                c6r_recovery_question, c7_contact, c8_drive_velocity, fig1b)
+from .readings import DEFAULT_READING, READINGS, Reading, split_study_name, study_name
 from .measure import friction_held, onset_amplitude, recovery, stable_roots_near, transition_bracket
 from .study import RESOLUTIONS, Claim, Resolution, Runner, Study, counts, load_studies, save_studies, timing
 
@@ -26,21 +27,33 @@ CLAIMS: dict[str, Claim] = {module.CLAIM.name: module.CLAIM for module in (
 STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 
 
-def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: bool = True) -> dict[str, Study]:
-    """Run the named studies in order; {claim: Study}, each with its timing."""
+def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: bool = True,
+                readings: bool = True) -> dict[str, Study]:
+    """Run the named studies in order, each under every reading its claim lists (only the
+    default one if ``readings`` is false or the resolution measures the default reading
+    only); {study name: Study} (:func:`.readings.study_name`), each with its timing."""
+    readings = readings and runner.resolution.readings
+    jobs = [(name, reading) for name in names
+            for reading in (CLAIMS[name].readings if readings else (DEFAULT_READING,))]
     results = {}
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=len(names), desc="claims", unit="claim", position=0)
+        bar = tqdm(total=len(jobs), desc="claims", unit="study", position=0)
     try:
-        for name in names:
+        for name, reading in jobs:
+            key = study_name(name, reading)
             if bar is not None:
-                bar.set_postfix_str(name)
+                bar.set_postfix_str(key)
             before, started = counts(runner), time.perf_counter()
-            results[name] = CLAIMS[name].study(runner)
-            results[name].timing = timing(time.perf_counter() - started, before, counts(runner))
+            runner.reading = reading
+            try:
+                results[key] = CLAIMS[name].study(runner)
+            finally:
+                runner.reading = DEFAULT_READING
+            results[key].reading = reading.key
+            results[key].timing = timing(time.perf_counter() - started, before, counts(runner))
             if bar is not None:
                 bar.update(1)
     finally:
@@ -49,6 +62,6 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
     return results
 
 
-__all__ = ["CLAIMS", "Claim", "RESOLUTIONS", "Resolution", "Runner", "STUDIES", "Study", "friction_held",
-           "load_studies", "onset_amplitude", "recovery", "run_studies", "save_studies", "stable_roots_near",
-           "transition_bracket"]
+__all__ = ["CLAIMS", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading", "Resolution", "Runner", "STUDIES", "Study", "friction_held",
+           "load_studies", "onset_amplitude", "recovery", "run_studies", "save_studies", "split_study_name",
+           "stable_roots_near", "study_name", "transition_bracket"]

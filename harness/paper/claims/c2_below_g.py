@@ -11,6 +11,7 @@ from harness.runs.sweep import Axis, Grid
 
 from .measure import OBSERVE_A_BURSTS, SCALED, jsonable_float, observe_json
 from .study import Claim, Runner, Study
+from .readings import A_READINGS
 from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, fmt, relative
 
 TEXT = {
@@ -65,4 +66,4 @@ def verdict_c2(m: dict) -> Row:
                "mu_s N(t) oscillates with the plate")
 
 
-CLAIM = Claim("C2", study_c2, verdict_c2, TEXT, FIGURES, None)
+CLAIM = Claim("C2", study_c2, verdict_c2, TEXT, FIGURES, None, readings=A_READINGS)

@@ -10,8 +10,9 @@ import math
 
 import numpy as np
 
-from .measure import OBSERVE_B, SCALED, VALLEY, WAVELENGTH, b_point, observe_json, run_and_measure
+from .measure import OBSERVE_B, OMEGA_X, SCALED, VALLEY, WAVELENGTH, b_point, observe_json, run_and_measure
 from .study import Claim, Runner, Study
+from .readings import READINGS
 from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, fmt, relative
 
 ROOT_TOLERANCE = 0.02
@@ -23,7 +24,7 @@ TEXT = {
 }
 FIGURES = {
     "C5a": ["model_b_x_t.png"],
-    "C5b": ["model_b_x_t.png"],
+    "C5b": ["model_b_x_t.png", "fig4_eq9_roots.png"],
     "C5c": ["model_b_x_t.png"],
 }
 
@@ -51,7 +52,8 @@ def study_c5(runner: Runner) -> Study:
         run["max_x_difference"] = float(np.max(np.abs(other - reference)))
     frictionless = results[-1]
     obs = frictionless["observables"]
-    measured = {"omega": omega, "runs": runs, "wavelength": WAVELENGTH, "V_d": SCALED["V_d"],
+    measured = {"omega": omega, "runs": runs, "wavelength": WAVELENGTH, "V_d": SCALED["V_d"], "omega_x": OMEGA_X,
+                "eq9_slope": eq9_slope(),
                 "frictionless": {"regime": obs["regime"], "slip_events": obs["slip_events"],
                                  "slip_length": obs["slip_length_mean"],
                                  "root_distance_median": frictionless["root_distance_median"],
@@ -63,6 +65,42 @@ def study_c5(runner: Runner) -> Study:
     data = {"traces": [{"A": a, **r["trace"]} for a, r in zip(res.b_amplitudes, results)],
             "frictionless_trace": frictionless["trace"]}
     return Study("C5", measured, settings, data)
+
+
+def eq9_slope(k_d: float = SCALED["k_d"], amplitude_x: float = 1e3, omega_x: float = OMEGA_X, m: float = 1.0,
+              g: float = 1.0) -> float:
+    """K of the paper's Eq. (9), cos(omega_x x*) = K (x* - V_d t): K = -k_d/(A_x omega_x m g)."""
+    return -k_d / (amplitude_x * omega_x * m * g)
+
+
+def eq9_roots(drive: float, k_ratio: float, omega_x: float, low: float, high: float) -> tuple[list, list]:
+    """Stable (sin(omega_x x*) < 0) and unstable roots of Eq. (9) in [low, high]."""
+    grid = np.linspace(low, high, 20001)
+    h = np.cos(omega_x * grid) - k_ratio * (grid - drive)
+    change = np.flatnonzero(np.sign(h[:-1]) != np.sign(h[1:]))
+    roots = grid[change] - h[change] * (grid[change + 1] - grid[change]) / (h[change + 1] - h[change])
+    stable = np.sin(omega_x * roots) < 0
+    return roots[stable].tolist(), roots[~stable].tolist()
+
+
+def stick_snapshots(time, x, count: int = 3) -> list[tuple[float, float]]:
+    """(t, x) in the middle of ``count`` separate stick phases of a trace (x nearly constant
+    between samples), spread over the trace; fewer if it has fewer sticks."""
+    time, x = np.asarray(time), np.asarray(x)
+    if len(time) < 3:
+        return []
+    speed = np.abs(np.diff(x) / np.diff(time))
+    still = speed < 0.05 * (np.max(speed) if np.max(speed) > 0 else 1.0)
+    phases, start = [], None
+    for i, s in enumerate(np.append(still, False)):
+        if s and start is None:
+            start = i
+        elif not s and start is not None:
+            if i - start >= 3:
+                phases.append((start + i) // 2)
+            start = None
+    chosen = [phases[int(j)] for j in np.linspace(0, len(phases) - 1, min(count, len(phases)))] if phases else []
+    return [(float(time[i]), float(x[i])) for i in dict.fromkeys(chosen)]
 
 
 def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
@@ -117,6 +155,37 @@ def draw(study: Study, save) -> None:
     ax.set(xlabel=r"$t$", ylabel="x", title=f"Model B, $\\omega$ = {study.measured['omega']:g}")
     ax.legend(fontsize="small")
     save(fig, "model_b_x_t.png")
+    draw_fig4(study, save)
 
 
-CLAIM = Claim("C5", study_c5, verdict_c5, TEXT, FIGURES, draw)
+def draw_fig4(study: Study, save) -> None:
+    """The paper's Fig. 4: the graphical solution of Eq. (9) at three times of the k_t = 0 run,
+    its stable (filled) and unstable (open) roots, and where the simulated block sticks."""
+    import matplotlib.pyplot as plt
+
+    m = study.measured
+    k_ratio, omega_x, v_d = m.get("eq9_slope", eq9_slope()), m.get("omega_x", OMEGA_X), m["V_d"]
+    trace = study.data["frictionless_trace"]
+    snapshots = stick_snapshots(trace["time"], trace["x"])
+    if not snapshots:
+        return
+    low = min(x for _, x in snapshots) - 0.75 * m["wavelength"]
+    high = max(x for _, x in snapshots) + 0.75 * m["wavelength"]
+    grid = np.linspace(low, high, 2000)
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    ax.plot(grid, np.cos(omega_x * grid), "k-", lw=1, label=r"$\cos(\omega_x x)$")
+    for number, (t, x) in enumerate(snapshots):
+        color = f"C{number}"
+        ax.plot(grid, k_ratio * (grid - v_d * t), "--", color=color, lw=1, label=f"$K(x - V_d t)$, t = {t:.3g}")
+        stable, unstable = eq9_roots(v_d * t, k_ratio, omega_x, low, high)
+        ax.plot(stable, np.cos(omega_x * np.asarray(stable)), "o", color=color, ms=6)
+        ax.plot(unstable, np.cos(omega_x * np.asarray(unstable)), "o", color=color, mfc="none", ms=6)
+        ax.axvline(x, color=color, lw=2, alpha=0.5)
+    ax.set(xlabel="x", ylabel="", title="Eq. (9), model B, $k_t$ = 0 (scaled drive): roots filled = stable, "
+           "open = unstable;\nvertical bars: where the simulated block sticks")
+    ax.title.set_fontsize("small")
+    ax.legend(fontsize="x-small", loc="lower left")
+    save(fig, "fig4_eq9_roots.png")
+
+
+CLAIM = Claim("C5", study_c5, verdict_c5, TEXT, FIGURES, draw, readings=READINGS)

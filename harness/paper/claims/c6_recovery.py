@@ -1,11 +1,16 @@
 """C6 -- model C (confining load): both transitions in the A-omega plane, friction recovery at omega_2.
 
+Each A row of the diagram brackets its friction loss (omega_1) and recovery (omega_2)
+on the omega grid; both brackets are then bisected in omega to ``BOUNDARY_RESOLUTION``
+(all rows per round in one batch), and the verdicts judge the located values.
+
 Criteria: C6a: k_t = 0 run not in stick-slip.  C6b: in every A row that loses friction,
-the grid omegas bracketing the loss contain sqrt(P_l/(m A)).  C6c: every row that loses
-friction regains it (omega_2) and k_n/gamma_n lies within ``RECOVERY_SLACK`` of the
-bracket [last sliding omega, omega_2]; omega_2 equal in all rows.  C6d: at each
-k_n/gamma_n, omega_2 (in units of k_n/gamma_n) spreads over at most one grid step across
-k_n.  C6e: up and down ramps regain friction at the same omega."""
+sqrt(P_l/(m A)) lies within FORMULA_TOLERANCE of the located omega_1 (inside the grid
+bracket where nothing was located).  C6c: every row that loses friction regains it, the
+located omega_2 lies within ``RECOVERY_SLACK`` of k_n/gamma_n (the paper says "about"),
+and the rows' omega_2 agree within UNCHANGED_TOLERANCE of their mean ("independent of
+A").  C6d: at each k_n/gamma_n, omega_2 (in units of k_n/gamma_n) spreads over at most
+one grid step across k_n.  C6e: up and down ramps regain friction at the same omega."""
 from __future__ import annotations
 
 import math
@@ -13,6 +18,7 @@ import math
 import numpy as np
 
 from harness.paper.plots import regime_scatter
+from harness.runs.bisection import Transition, refine
 from harness.runs.continuation import Ramp
 from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
@@ -20,9 +26,12 @@ from harness.runs.sweep import Axis, Grid
 from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, c_run, friction_held, observe_json, onset_amplitude,
                       onset_omega, ramp_task, recovery, run_and_measure)
 from .study import Claim, Runner, Study
-from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, Row, combine, fmt
+from .readings import READINGS
+from .verdicts import (AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, combine,
+                       fmt, relative)
 
 RECOVERY_SLACK = 0.25
+BOUNDARY_RESOLUTION = 0.03  # relative width in omega to which both transitions are bisected
 
 TEXT = {
     "C6a": "C: no stick-slip with k_t = 0",
@@ -63,6 +72,7 @@ def study_c6(runner: Runner) -> Study:
         rows.append({"A": float(amplitude), "regimes": regimes, **found,
                      "first_transition_paper": math.sqrt(1.0 / float(amplitude)),
                      "first_transition_onset": onset_omega(float(amplitude), 0.07)})
+    _locate_transitions(runner, base, rows)
 
     stiffness_amplitude = 0.5
     base_k = PointSettings(run=c_run(runner, res.c_horizon, A=stiffness_amplitude), observe=observe_c)
@@ -91,7 +101,7 @@ def study_c6(runner: Runner) -> Study:
                          "slip_events": frictionless["observables"]["slip_events"],
                          "phi": frictionless["observables"]["phi"],
                          "drift_velocity": frictionless["observables"]["drift_velocity"]},
-        "diagram_rows": rows, "omegas": diagram.omega.values.tolist(),
+        "diagram_rows": rows, "omegas": diagram.omega.values.tolist(), "resolution": BOUNDARY_RESOLUTION,
         "stiffness_amplitude": stiffness_amplitude, "recovery_vs_k": recovery_vs_k,
         "ramp_amplitude": ramp_amplitude, "ramp_values": list(res.c6_ramp),
         "ramp_up_omega_2": up_rec["omega_2"],
@@ -107,6 +117,43 @@ def study_c6(runner: Runner) -> Study:
     return Study("C6", measured, settings, data)
 
 
+def _locate_transitions(runner: Runner, base: PointSettings, rows: list[dict]) -> None:
+    """Bisect each row's loss bracket (last friction, omega_1] and recovery bracket
+    (last sliding, omega_2] in omega; adds located_omega_1/2 and their brackets to the rows."""
+    found = []
+    for row in rows:
+        if row["omega_1"] is not None and row["last_friction_before_1"] is not None:
+            found.append(Transition(row["last_friction_before_1"], row["omega_1"], True, where={"A": row["A"]}))
+        if row["omega_2"] is not None:
+            found.append(Transition(row["last_sliding"], row["omega_2"], False, where={"A": row["A"]}))
+
+    def classify(pairs):
+        items = [{"point": PointSettings(run=base.run.with_parameters({"A": t.where["A"], "omega": w}),
+                                         observe=base.observe)} for t, w in pairs]
+        return [friction_held(r["observables"]["regime"]) for r in runner.tasks(run_and_measure, items)]
+
+    refine(classify, found, BOUNDARY_RESOLUTION)
+    for row in rows:
+        for transition_name, held_lo in (("omega_1", True), ("omega_2", False)):
+            t = next((t for t in found if t.where["A"] == row["A"] and t.held_lo == held_lo), None)
+            row.update({f"located_{transition_name}": t.value if t else None,
+                        f"located_{transition_name}_bracket": [t.lo, t.hi] if t else None})
+
+
+def _near(row: dict, line: float) -> bool:
+    """``line`` agrees with the row's first transition: within FORMULA_TOLERANCE of the located
+    omega_1, or (nothing located) inside the grid bracket."""
+    if row.get("located_omega_1") is not None:
+        return relative(row["located_omega_1"], line) <= FORMULA_TOLERANCE
+    return ((row["last_friction_before_1"] is None or row["last_friction_before_1"] <= line)
+            and line <= row["omega_1"])
+
+
+def _omega_2(row: dict) -> float | None:
+    """The row's recovery: the located omega_2, or the grid value where nothing was located."""
+    return row.get("located_omega_2") or row["omega_2"]
+
+
 def verdict_c6(m: dict) -> list[Row]:
     rows = []
     free = m["frictionless"]
@@ -118,37 +165,39 @@ def verdict_c6(m: dict) -> list[Row]:
     diagram = m["diagram_rows"]
     losing = [r for r in diagram if r["omega_1"] is not None]
     measured = "; ".join(f"A = {r['A']:g}: friction lost at w in ({fmt(r['last_friction_before_1'])}, "
-                         f"{fmt(r['omega_1'])}] (sqrt(P_l/mA) = {r['first_transition_paper']:.3g}, "
-                         f"A_c onset {fmt(r['first_transition_onset'])}), regained at {fmt(r['omega_2'])}"
-                         for r in diagram)
+                         f"{fmt(r['omega_1'])}], located {fmt(r.get('located_omega_1'))} (sqrt(P_l/mA) = "
+                         f"{r['first_transition_paper']:.3g}, A_c onset {fmt(r['first_transition_onset'])}), regained "
+                         f"at {fmt(r['omega_2'])}, located {fmt(r.get('located_omega_2'))}" for r in diagram)
+    measured += f" (located to {m.get('resolution', BOUNDARY_RESOLUTION):.0%} in omega)"
     if not losing:
         rows.append(Row("C6b", measured, NOT_REPRODUCED, "no row loses friction in the scanned omega range"))
     else:
-        ok = [r for r in losing if (r["last_friction_before_1"] is None
-                                    or r["last_friction_before_1"] <= r["first_transition_paper"])
-              and r["first_transition_paper"] <= r["omega_1"]]
+        ok = [r for r in losing if _near(r, r["first_transition_paper"])]
         rows.append(Row("C6b", measured, AGREES if len(ok) == len(losing) else DISAGREES,
-                        f"sqrt(P_l/mA) bracketed in {len(ok)}/{len(losing)} rows that lose friction"))
+                        f"sqrt(P_l/mA) within {FORMULA_TOLERANCE:.0%} of the located loss (or inside its grid "
+                        f"bracket) in {len(ok)}/{len(losing)} rows that lose friction"))
 
     ratio = m["k_n_over_gamma_n"]
     recovered = [r for r in losing if r["omega_2"] is not None]
     measured = (f"k_n/gamma_n = {ratio:.3g}; omega_2 per A: "
-                + ", ".join(f"A = {r['A']:g}: {fmt(r['omega_2'])}" for r in losing))
+                + ", ".join(f"A = {r['A']:g}: {fmt(_omega_2(r))}" for r in losing))
     if not losing:
         rows.append(Row("C6c", measured, NOT_REPRODUCED, "no sliding region to recover from"))
     elif not recovered:
         rows.append(Row("C6c", measured, DISAGREES,
                         f"no row regains friction up to w = {max(m['omegas']):g}"))
     else:
-        near = [r for r in recovered if r["last_sliding"] * (1 - RECOVERY_SLACK) <= ratio
-                <= r["omega_2"] * (1 + RECOVERY_SLACK)]
-        same = len({r["omega_2"] for r in recovered}) == 1
+        found = [_omega_2(r) for r in recovered]
+        near = [w for w in found if relative(w, ratio) <= RECOVERY_SLACK]
+        mean = float(np.mean(found))
+        spread = max(relative(w, mean) for w in found)
+        same = spread <= UNCHANGED_TOLERANCE
         parts = [(AGREES if len(recovered) == len(losing) else DISAGREES,
                   f"{len(recovered)}/{len(losing)} rows that lose friction regain it"),
                  (AGREES if len(near) == len(recovered) else DISAGREES,
-                  f"k_n/gamma_n within the recovery bracket (+-{RECOVERY_SLACK:.0%}) in {len(near)}/{len(recovered)}"),
-                 (AGREES if same else DISAGREES, "omega_2 the same grid value in all rows" if same
-                  else "omega_2 differs between rows")]
+                  f"omega_2 within {RECOVERY_SLACK:.0%} of k_n/gamma_n in {len(near)}/{len(recovered)}"),
+                 (AGREES if same else DISAGREES, f"omega_2 within {spread:.0%} of its mean over the rows "
+                  f"(<= {UNCHANGED_TOLERANCE:.0%} counts as independent of A)")]
         verdict, reason = combine(parts)
         rows.append(Row("C6c", measured, verdict, reason))
 
@@ -194,6 +243,11 @@ def draw(study: Study, save) -> None:
     ax.plot(line, 1 / line**2, "k:", label=r"$A = P_l/(m\omega^2)$")
     ax.plot(line, onset_amplitude(line), "k-", lw=1, label=r"$A_c(\omega)$ with $P_l$")
     ax.axvline(study.measured["k_n_over_gamma_n"], color="tab:green", ls="--", label=r"$k_n/\gamma_n$")
+    for key, marker, label in (("located_omega_1", "D", r"friction lost (bisected)"),
+                               ("located_omega_2", "^", r"friction back (bisected)")):
+        points = [(r[key], r["A"]) for r in study.measured["diagram_rows"] if r.get(key) is not None]
+        if points:
+            ax.plot(*zip(*points), marker, color="k", mfc="none", ls="none", label=label)
     ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A", title="Model C")
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
     ax.legend(fontsize="small")
@@ -217,4 +271,4 @@ def draw(study: Study, save) -> None:
     save(fig, "omega2_vs_k_n.png")
 
 
-CLAIM = Claim("C6", study_c6, verdict_c6, TEXT, FIGURES, draw)
+CLAIM = Claim("C6", study_c6, verdict_c6, TEXT, FIGURES, draw, readings=READINGS)

@@ -100,7 +100,7 @@ SIZES = {
     # amplitudes below delta_0 can lose friction (a band of width ~1.35 at A = 0.3 delta_0).
     "default": Sizes(amplitudes=(0.3, 0.6), amplitudes_c=(0.3,),
                      omegas=tuple(np.round(np.concatenate([np.geomspace(0.3, 3.0, 13), np.geomspace(3.0, 60.0, 7)[1:]]), 4)),
-                     omegas_c=(0.3, 0.6, 0.85, 1.0, 1.15, 1.4, 2.5, 6.0, 15.0, 40.0), ramp_points=5,
+                     omegas_c=(0.3, 0.85, 1.0, 1.15, 1.4, 6.0, 40.0), ramp_points=5,
                      stiffnesses=(0.5, 1.0, 2.0), configurations=tuple(c.label for c in CONFIGURATIONS)),
     "quick": Sizes(amplitudes=(0.3,), amplitudes_c=(), omegas=(0.5, 0.8, 1.0, 1.25, 1.6, 3.0, 10.0, 30.0, 60.0),
                    omegas_c=(), ramp_points=4, stiffnesses=(0.5, 2.0), configurations=("A, contact-force bound",)),

@@ -18,6 +18,7 @@ from harness.runs.sweep import Axis, Grid
 from .measure import C_PARAMETERS, C_START, OBSERVE_A, OBSERVE_SHORT, SCALED, c_run, friction_held, observe_json, \
     run_and_measure
 from .study import Claim, Runner, Study
+from .readings import READINGS
 from .verdicts import AGREES, DISAGREES, FORMULA_TOLERANCE, Row, combine, fmt, relative
 
 TEXT = {
@@ -120,4 +121,4 @@ def draw(study: Study, save) -> None:
         save(fig, name)
 
 
-CLAIM = Claim("C8", study_c8, verdict_c8, TEXT, FIGURES, draw)
+CLAIM = Claim("C8", study_c8, verdict_c8, TEXT, FIGURES, draw, readings=READINGS)

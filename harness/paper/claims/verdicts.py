@@ -5,7 +5,10 @@ Verdicts are computed from the numbers a study measured, never written by hand:
 * ``agrees``: the claim's criterion holds;
 * ``disagrees``: it was measured and does not hold;
 * ``not reproduced``: the study could not measure what the criterion needs (e.g. no
-  transition in the scanned range, no complete slip in the window).
+  transition in the scanned range, no complete slip in the window);
+* ``flips with the reading``: the claim was measured under several readings of the
+  paper's equations (:mod:`.readings`) and its verdict is not the same under all of them
+  (the report gives each).
 
 Each claim's module states its criteria; the tolerances several claims use are here.
 """
@@ -18,6 +21,7 @@ from typing import Sequence
 import numpy as np
 
 AGREES, DISAGREES, NOT_REPRODUCED = "agrees", "disagrees", "not reproduced"
+FLIPS = "flips with the reading"
 FORMULA_TOLERANCE = 0.10    # relative, a measured value against its formula
 UNCHANGED_TOLERANCE = 0.10  # relative, "unchanged" against a reference run
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from harness.paper import report
-from harness.paper.claims import load_studies
-from harness.paper.claims.verdicts import AGREES, DISAGREES, NOT_REPRODUCED, fmt
+from harness.paper.claims import CLAIMS, load_studies, study_name
+from harness.paper.claims.verdicts import AGREES, DISAGREES, FLIPS, NOT_REPRODUCED, fmt
 
 
 @pytest.fixture(scope="module")
@@ -23,12 +23,18 @@ def test_tiny_main_job_writes_a_report_from_its_measurements(tiny_job):
     out, path = tiny_job
     text = path.read_text()
     studies = load_studies(out / "claims.json")
-    assert set(studies) == {"Fig1b", "C6r"} | {f"C{n}" for n in range(1, 9)}
+    assert set(studies) == {study_name(name, r) for name, claim in CLAIMS.items() for r in claim.readings}
+    assert {"Fig1b", "C6r"} | {f"C{n}" for n in range(1, 9)} <= set(studies)
     rows = report.claim_rows(studies)
     for row in rows:
         assert f"| {row.claim} |" in text
         assert f"**{row.verdict}**" in text
-        assert row.verdict in (AGREES, DISAGREES, NOT_REPRODUCED)
+        assert row.verdict in (AGREES, DISAGREES, NOT_REPRODUCED, FLIPS)
+    # The claims the readings can change are set side by side, each part under every reading.
+    assert "## The readings side by side" in text
+    for part, per_reading in report.reading_rows(studies).items():
+        assert len(per_reading) == len(CLAIMS[part[:2]].readings), part
+        assert f"| {part} | **{per_reading[next(iter(per_reading))].verdict}**" in text
     c1 = studies["C1"].measured
     assert f"stick time {fmt(c1['stick_time'])} vs" in text
     assert c1["rest_penetration"] == pytest.approx(1.0, rel=0.02)

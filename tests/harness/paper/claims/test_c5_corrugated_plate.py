@@ -1,0 +1,46 @@
+"""C5: the paper's Eq. (9) solved graphically (Fig. 4), on synthetic traces."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from harness.paper.claims.c5_corrugated_plate import draw_fig4, eq9_roots, eq9_slope, stick_snapshots
+from harness.paper.claims.measure import stable_roots_near
+from harness.paper.claims.study import Study
+
+
+def test_eq9_roots_solve_the_equation_and_stable_ones_are_those_the_study_measures_against():
+    k_ratio, omega_x, drive = eq9_slope(), 0.02, 123.0
+    assert k_ratio == pytest.approx(-1e-2 / (1e3 * 0.02))
+    stable, unstable = eq9_roots(drive, k_ratio, omega_x, -500.0, 500.0)
+    assert len(stable) >= 2 and len(unstable) >= 2
+    for root in stable + unstable:
+        assert math.cos(omega_x * root) == pytest.approx(k_ratio * (root - drive), abs=1e-6)
+    for root in stable:
+        assert math.sin(omega_x * root) < 0
+        assert stable_roots_near(root, drive, k_ratio, omega_x) == pytest.approx(root, abs=0.5)
+    assert all(math.sin(omega_x * r) > 0 for r in unstable)
+
+
+def test_stick_snapshots_take_one_time_in_each_of_three_separate_sticks():
+    t = np.arange(0.0, 1000.0)
+    x = np.interp(t, [0, 200, 250, 500, 550, 800, 850, 999], [0, 0, 50, 50, 100, 100, 150, 150])
+    snapshots = stick_snapshots(t, x)
+    assert [x for _, x in snapshots] == [0.0, 50.0, 150.0] or [x for _, x in snapshots] == [0.0, 100.0, 150.0]
+    assert len({x for _, x in snapshots}) == 3
+    assert stick_snapshots(t, 0.1 * t) == []  # no stick: nothing to draw on
+
+
+def test_fig4_is_drawn_from_the_k_t_zero_trace(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    t = np.arange(0.0, 1000.0)
+    x = np.interp(t, [0, 300, 350, 999], [230, 230, 540, 540])
+    study = Study("C5", {"V_d": 1e-2, "wavelength": 2 * math.pi / 0.02, "omega_x": 0.02, "eq9_slope": eq9_slope()},
+                  {}, {"frictionless_trace": {"time": t.tolist(), "x": x.tolist()}})
+    saved = []
+    draw_fig4(study, lambda fig, name: (fig.savefig(tmp_path / name), saved.append(name)))
+    assert saved == ["fig4_eq9_roots.png"] and (tmp_path / "fig4_eq9_roots.png").stat().st_size > 10_000
