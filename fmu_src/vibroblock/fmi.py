@@ -36,6 +36,9 @@ from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
 _NAMESPACES_RELEASED_BY_LOADER: list = []
+# A doStep's communication point may differ from the FMU's time by this much relative
+# (masters that compute k h instead of accumulating); the step then starts at the FMU's time.
+TIME_TOLERANCE = 1e-9
 
 # The native front end (build/fmi_status_shim.c) calls a slave's do_step itself, without
 # pythonfmu's per-call work (method lookup, argument tuple, log-queue scan): right after
@@ -144,7 +147,7 @@ class FmuFacade(Fmi2Slave):
         if not 0.0 < step_size < math.inf:  # NaN fails too
             raise self.rejected[0](f"communication step size {step_size!r} must be a finite number > 0")
         now = self._time()
-        if not abs(current_time - now) <= 1e-9 * max(1.0, abs(now)):  # NaN and infinities fail too
+        if not abs(current_time - now) <= TIME_TOLERANCE * max(1.0, abs(now)):  # NaN and infinities fail too
             raise self.rejected[0](f"communication point {current_time!r} differs from the FMU's time {now!r}; "
                                    "to go back in time restore an FMU state first")
         return now + step_size
