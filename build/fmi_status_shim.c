@@ -281,6 +281,7 @@ __attribute__((destructor)) static void unload_inner_library(void)
 typedef struct {
     fmi2Component         component;   /* the inner library's instance */
     char*                 name;        /* instanceName, for messages from here */
+    char*                 resources;   /* fmuResourceLocation, to find the slave again after a reset */
     int                   dead;        /* the inner instance answered fmi2Fatal */
     fmi2CallbackFunctions host;        /* the caller's callbacks, as given */
     fmi2CallbackFunctions given;       /* what the inner library gets; it keeps the pointer */
@@ -288,6 +289,9 @@ typedef struct {
     fmi2Boolean           debugLogging;
     size_t                nCategories; /* 0: all categories */
     char**                categories;
+    PythonSlave           slave;       /* its Python slave, whose do_step fmi2DoStep calls directly */
+    int                   stepped;     /* the last step taken went the direct way: lastSuccessfulTime is ours */
+    fmi2Real              lastSuccessfulTime;
 } Instance;
 
 static void forget_categories(Instance* inst)
@@ -430,6 +434,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     inst->given.stepFinished = inst->host.stepFinished != NULL ? shim_step_finished : NULL;
     inst->given.componentEnvironment = inst;
     inst->name = strdup(instanceName != NULL ? instanceName : "");
+    inst->resources = strdup(fmuResourceLocation != NULL ? fmuResourceLocation : "");
 
     /* Debug logging on inside: messages of every status must pass through
      * shim_logger for the status to be seen at all. */
@@ -437,9 +442,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                                             &inst->given, visible, fmi2True);
     if (inst->component == NULL) {
         free(inst->name);
+        free(inst->resources);
         free(inst);
         return NULL;
     }
+    python_slave_claim(&inst->slave, instanceName, fmuResourceLocation);
     return inst;
 }
 
@@ -451,6 +458,7 @@ void fmi2FreeInstance(fmi2Component c)
      * destroyed, and with debug logging on that crashes the host (seen when an
      * instance is freed right after fmi2Instantiate).  Nothing logged while
      * freeing is of use to the host, so logging goes off first. */
+    python_slave_release(&inst->slave);
     if (!inst->dead) {
         inner.fmi2SetDebugLogging(inst->component, fmi2False, 0, NULL);
         inner.fmi2FreeInstance(inst->component);
@@ -459,6 +467,7 @@ void fmi2FreeInstance(fmi2Component c)
      * instance would release them again: the small remainder is left alone. */
     forget_categories(inst);
     free(inst->name);
+    free(inst->resources);
     free(inst);
 }
 
@@ -520,7 +529,20 @@ FORWARD(fmi2SetupExperiment,
 FORWARD(fmi2EnterInitializationMode, (fmi2Component c), inst->component)
 FORWARD(fmi2ExitInitializationMode, (fmi2Component c), inst->component)
 FORWARD(fmi2Terminate, (fmi2Component c), inst->component)
-FORWARD(fmi2Reset, (fmi2Component c), inst->component)
+
+/* pythonfmu makes a new Python slave on reset: the direct doStep follows it. */
+fmi2Status fmi2Reset(fmi2Component c)
+{
+    Instance* inst = (Instance*)c;
+    if (inst == NULL) return fmi2Error;
+    inst->logged = fmi2OK;
+    if (inst->dead) return refuse_dead(inst, "fmi2Reset");
+    python_slave_release(&inst->slave);
+    fmi2Status returned = inner.fmi2Reset(inst->component);
+    if (returned == fmi2Fatal) inst->dead = 1;
+    else python_slave_claim(&inst->slave, inst->name, inst->resources);
+    return worse(returned, inst->logged);
+}
 
 FORWARD_VALUES(fmi2GetReal, 'r', 0,
                (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]))
@@ -561,14 +583,59 @@ FORWARD(fmi2GetRealOutputDerivatives,
         (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[], fmi2Real value[]),
         inst->component, vr, nvr, order, value)
 
-FORWARD(fmi2DoStep,
-        (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
-         fmi2Boolean noSetFMUStatePriorToCurrentPoint),
-        inst->component, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint)
+static void report_from_slave(void* context, int status, const char* category, const char* message)
+{
+    Instance* inst = (Instance*)context;
+    shim_logger(inst, inst->name, (fmi2Status)status, category, message);
+}
+
+/* The slave's do_step called directly (python_runtime.c says why), with what pythonfmu
+ * would do around it: True is fmi2OK, False fmi2Discard (raised to fmi2Error by the
+ * error the slave logged), and the end of the last step taken kept for
+ * fmi2GetRealStatus(fmi2LastSuccessfulTime) (a refused step leaves it, where pythonfmu
+ * would record the refused step's start).  Without a claimed slave
+ * (VIBROBLOCK_PYTHONFMU_DOSTEP=1, a slave that is no vibroblock facade, a Python without
+ * the functions used) the call goes to pythonfmu. */
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+{
+    Instance* inst = (Instance*)c;
+    if (inst == NULL) return fmi2Error;
+    inst->logged = fmi2OK;
+    if (inst->dead) return refuse_dead(inst, "fmi2DoStep");
+    if (inst->slave.do_step == NULL) {
+        fmi2Status returned = inner.fmi2DoStep(inst->component, currentCommunicationPoint, communicationStepSize,
+                                               noSetFMUStatePriorToCurrentPoint);
+        if (returned == fmi2Fatal) inst->dead = 1;
+        inst->stepped = 0;  /* pythonfmu's record is the current one again */
+        return worse(returned, inst->logged);
+    }
+    int taken = python_slave_do_step(&inst->slave, currentCommunicationPoint, communicationStepSize,
+                                     report_from_slave, inst);
+    if (taken) {
+        inst->stepped = 1;
+        inst->lastSuccessfulTime = currentCommunicationPoint + communicationStepSize;
+    }
+    return worse(taken ? fmi2OK : fmi2Discard, inst->logged);
+}
 FORWARD(fmi2CancelStep, (fmi2Component c), inst->component)
 
 FORWARD(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Status* value), inst->component, s, value)
-FORWARD(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Real* value), inst->component, s, value)
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value)
+{
+    Instance* inst = (Instance*)c;
+    if (inst == NULL) return fmi2Error;
+    inst->logged = fmi2OK;
+    if (inst->dead) return refuse_dead(inst, "fmi2GetRealStatus");
+    if (inst->stepped && s == fmi2LastSuccessfulTime && value != NULL) {
+        *value = inst->lastSuccessfulTime;  /* the direct doStep's record (pythonfmu's is older) */
+        return fmi2OK;
+    }
+    fmi2Status returned = inner.fmi2GetRealStatus(inst->component, s, value);
+    if (returned == fmi2Fatal) inst->dead = 1;
+    return worse(returned, inst->logged);
+}
 FORWARD(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Integer* value),
         inst->component, s, value)
 FORWARD(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value),

@@ -79,6 +79,23 @@ static struct {
     PyObj Py_None;
 } py;
 
+/* What python_slave_* use besides (also stable ABI, Python >= 3.2; PyObject_Vectorcall,
+ * 3.9+, is taken when present: it calls without building an argument tuple).  Bound
+ * apart: without them the FMU still works, its doSteps through pythonfmu. */
+static struct {
+    PyObj (*PyFloat_FromDouble)(double);
+    PyObj (*PyObject_CallFunctionObjArgs)(PyObj, ...);
+    PyObj (*PyObject_Vectorcall)(PyObj, PyObj const*, size_t, PyObj);
+    PyObj (*PyObject_GetAttrString)(PyObj, const char*);
+    int (*PyObject_IsTrue)(PyObj);
+    long (*PyList_Size)(PyObj);
+    PyObj (*PyList_GetItem)(PyObj, long);
+    PyObj (*PyTuple_GetItem)(PyObj, long);
+    long (*PyLong_AsLong)(PyObj);
+    void (*PyErr_Clear)(void);
+    int bound;
+} slave_api;
+
 static int bind_api(void* handle)
 {
 #define BIND(name) if ((*(void**)&py.name = dlsym(handle, #name)) == NULL) return 0;
@@ -88,6 +105,15 @@ static int bind_api(void* handle)
     BIND(PyObject_CallMethod)
 #undef BIND
     if ((py.Py_None = dlsym(handle, "_Py_NoneStruct")) == NULL) return 0;
+#define BIND_SLAVE(name) *(void**)&slave_api.name = dlsym(handle, #name);
+    BIND_SLAVE(PyFloat_FromDouble) BIND_SLAVE(PyObject_CallFunctionObjArgs) BIND_SLAVE(PyObject_Vectorcall)
+    BIND_SLAVE(PyObject_GetAttrString) BIND_SLAVE(PyObject_IsTrue) BIND_SLAVE(PyList_Size)
+    BIND_SLAVE(PyList_GetItem) BIND_SLAVE(PyTuple_GetItem) BIND_SLAVE(PyLong_AsLong) BIND_SLAVE(PyErr_Clear)
+#undef BIND_SLAVE
+    slave_api.bound = slave_api.PyFloat_FromDouble && slave_api.PyObject_CallFunctionObjArgs &&
+                      slave_api.PyObject_GetAttrString && slave_api.PyObject_IsTrue && slave_api.PyList_Size &&
+                      slave_api.PyList_GetItem && slave_api.PyTuple_GetItem && slave_api.PyLong_AsLong &&
+                      slave_api.PyErr_Clear;
     return 1;
 }
 
@@ -430,4 +456,130 @@ int python_runtime_ready(const char* fmu_root, char* error, size_t size)
     if (check_modules(who, error, size)) return 1;
     how_to_fix(error, size);
     return 0;
+}
+
+/* ---- a slave's doStep, called directly ---------------------------------------- */
+
+/* pythonfmu 0.7.0 answers every fmi2DoStep with PyObject_CallMethod(slave, "do_step",
+ * "(dd)", ...) and then a scan of the slave's log queue that builds four attribute-name
+ * strings each time: some 0.5 us a call, a few percent of a doStep of a thousand
+ * internal steps.  The front end calls the slave's bound do_step itself instead (the
+ * same Python call, so the same results and FMU state), and reads the log queue only
+ * when it holds something.  Everything else stays with pythonfmu.  The slave is handed
+ * over by vibroblock.fmi (_claim_slave): the one its FmuFacade.__init__ registered on
+ * this thread while pythonfmu made it, if its instance name and resource folder are the
+ * ones given to pythonfmu.  A slave that is not a vibroblock facade (no such module or
+ * no such slave) keeps pythonfmu's doStep. */
+
+int python_slave_claim(PythonSlave* slave, const char* instance_name, const char* resource_location)
+{
+    memset(slave, 0, sizeof *slave);
+    if (!slave_api.bound) return 0;
+    const char* off = getenv("VIBROBLOCK_PYTHONFMU_DOSTEP");  /* "1": every doStep through pythonfmu */
+    if (off != NULL && strcmp(off, "1") == 0) return 0;
+    PyGILState gil = py.PyGILState_Ensure();
+    PyObj module = py.PyImport_ImportModule("vibroblock.fmi");
+    PyObj made = module != NULL ? py.PyObject_CallMethod(module, "_claim_slave", "ss", instance_name != NULL ? instance_name : "",
+                                                        resource_location != NULL ? resource_location : "") : NULL;
+    if (made != NULL && made != py.Py_None) {
+        slave->do_step = slave_api.PyObject_GetAttrString(made, "do_step");
+        slave->log_queue = slave->do_step != NULL ? slave_api.PyObject_GetAttrString(made, "log_queue") : NULL;
+        if (slave->log_queue != NULL && slave_api.PyList_Size(slave->log_queue) < 0) {  /* not a list */
+            py.Py_DecRef(slave->log_queue);
+            slave->log_queue = NULL;
+        }
+        if (slave->log_queue != NULL) {
+            slave->slave = made;
+            made = NULL;
+        } else if (slave->do_step != NULL) {
+            py.Py_DecRef(slave->do_step);
+            slave->do_step = NULL;
+        }
+    }
+    if (made != NULL) py.Py_DecRef(made);
+    if (module != NULL) py.Py_DecRef(module);
+    slave_api.PyErr_Clear();  /* nothing found is no error: pythonfmu's path is used */
+    py.PyGILState_Release(gil);
+    return slave->slave != NULL;
+}
+
+void python_slave_release(PythonSlave* slave)
+{
+    if (slave->slave == NULL) return;
+    PyGILState gil = py.PyGILState_Ensure();
+    py.Py_DecRef(slave->do_step);
+    py.Py_DecRef(slave->log_queue);
+    py.Py_DecRef(slave->slave);
+    py.PyGILState_Release(gil);
+    memset(slave, 0, sizeof *slave);
+}
+
+/* The exception set now as text, cleared. */
+static void report_exception(PythonSlaveReport report, void* context, const char* what)
+{
+    PyObj type = NULL, value = NULL, traceback = NULL;
+    py.PyErr_Fetch(&type, &value, &traceback);
+    PyObj text = value != NULL ? py.PyObject_Str(value) : type != NULL ? py.PyObject_Str(type) : NULL;
+    const char* utf8 = text != NULL ? py.PyUnicode_AsUTF8(text) : NULL;
+    char message[1024];
+    snprintf(message, sizeof message, "%s: %s; the FMU's state is as the failed call left it",
+             what, utf8 != NULL ? utf8 : "an exception without a message");
+    slave_api.PyErr_Clear();
+    report(context, 3 /* fmi2Error */, "logStatusError", message);
+    if (text != NULL) py.Py_DecRef(text);
+    if (type != NULL) py.Py_DecRef(type);
+    if (value != NULL) py.Py_DecRef(value);
+    if (traceback != NULL) py.Py_DecRef(traceback);
+}
+
+/* The slave's queued messages, passed on in order and taken off its queue. */
+static void report_messages(const PythonSlave* slave, PythonSlaveReport report, void* context)
+{
+    PyObj messages = py.PyObject_CallMethod(slave->slave, "_take_log", NULL);
+    long n = messages != NULL ? slave_api.PyList_Size(messages) : -1;
+    if (n < 0) {
+        report_exception(report, context, "doStep: cannot read the FMU's log messages");
+        if (messages != NULL) py.Py_DecRef(messages);
+        return;
+    }
+    for (long i = 0; i < n; i++) {
+        PyObj entry = slave_api.PyList_GetItem(messages, i);  /* borrowed, as the items below */
+        PyObj status = entry != NULL ? slave_api.PyTuple_GetItem(entry, 0) : NULL;
+        PyObj category = entry != NULL ? slave_api.PyTuple_GetItem(entry, 1) : NULL;
+        PyObj text = entry != NULL ? slave_api.PyTuple_GetItem(entry, 2) : NULL;
+        long level = status != NULL ? slave_api.PyLong_AsLong(status) : 3;
+        const char* category_utf8 = category != NULL ? py.PyUnicode_AsUTF8(category) : NULL;
+        const char* text_utf8 = text != NULL ? py.PyUnicode_AsUTF8(text) : NULL;
+        if (level < 0 || level > 4) level = 3;  /* not an fmi2Status: an error */
+        slave_api.PyErr_Clear();
+        report(context, (int)level, category_utf8 != NULL && category_utf8[0] ? category_utf8 : "logAll",
+               text_utf8 != NULL ? text_utf8 : "(a log message that is not text)");
+    }
+    py.Py_DecRef(messages);
+}
+
+int python_slave_do_step(const PythonSlave* slave, double t, double h, PythonSlaveReport report, void* context)
+{
+    PyGILState gil = py.PyGILState_Ensure();
+    int taken = 0;
+    PyObj args[2] = {slave_api.PyFloat_FromDouble(t), slave_api.PyFloat_FromDouble(h)};
+    PyObj result = NULL;
+    if (args[0] != NULL && args[1] != NULL)
+        result = slave_api.PyObject_Vectorcall != NULL
+                     ? slave_api.PyObject_Vectorcall(slave->do_step, args, 2, NULL)
+                     : slave_api.PyObject_CallFunctionObjArgs(slave->do_step, args[0], args[1], NULL);
+    for (int i = 0; i < 2; i++)
+        if (args[i] != NULL) py.Py_DecRef(args[i]);
+    if (result != NULL) {
+        taken = slave_api.PyObject_IsTrue(result) == 1;
+        py.Py_DecRef(result);
+        slave_api.PyErr_Clear();
+    } else {
+        /* The facades catch every Exception; what gets here (MemoryError in the
+         * interpreter, a BaseException) is reported, never passed on to the host. */
+        report_exception(report, context, "doStep: internal error in the Python slave");
+    }
+    if (slave_api.PyList_Size(slave->log_queue) > 0) report_messages(slave, report, context);
+    py.PyGILState_Release(gil);
+    return taken;
 }

@@ -10,4 +10,27 @@
  * with a message in `error` saying what is missing and how to fix it. */
 int python_runtime_ready(const char* fmu_root, char* error, size_t size);
 
+/* A Python slave's doStep called directly, without pythonfmu's per-call work (see
+ * python_runtime.c).  All members NULL: not available, use pythonfmu. */
+typedef struct {
+    void* slave;      /* the slave object */
+    void* do_step;    /* its bound do_step */
+    void* log_queue;  /* the list pythonfmu reads its messages from */
+} PythonSlave;
+
+/* A log message of a direct call: status (fmi2Status), category, text. */
+typedef void (*PythonSlaveReport)(void* context, int status, const char* category, const char* message);
+
+/* Take the slave pythonfmu has just made on this thread (after its fmi2Instantiate or
+ * fmi2Reset returned) for the instance of that name and resource location; returns 1,
+ * or 0 with all members NULL. */
+int python_slave_claim(PythonSlave* slave, const char* instance_name, const char* resource_location);
+
+/* Release what python_slave_claim took (all members NULL afterwards). */
+void python_slave_release(PythonSlave* slave);
+
+/* slave.do_step(t, h): 1 when it returned True, else 0.  Messages the slave logged, and
+ * an exception escaping it, are passed to `report` before this returns. */
+int python_slave_do_step(const PythonSlave* slave, double t, double h, PythonSlaveReport report, void* context);
+
 #endif

@@ -7,6 +7,7 @@ the FMU classes are thin facades over it.
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 
@@ -150,38 +151,52 @@ class Block:
         self._observe_at = kernel.bind_observe(*arrays)
         self._track_energy = settings.energy_balance
         self._grid = (float(self.drv[L.D_T0]), float(self.drv[L.D_DT]))
+        self._grid_step = partial(self.cnt.item, L.C_STEP)  # the grid index, read without a lookup
         self._step_budget = STEP_BUDGET_PER_CALL if kernel.force_evaluations > 0 else math.inf
 
     def advance_to(self, t_end: float) -> None:
         """Advance to t_end > current time; on failure the state is left unchanged."""
-        self._require_started()
-        if not (math.isfinite(t_end) and t_end > self.time):
+        # An FMU's doStep is this call, thousands of times per second at ~15 us of work
+        # each: everything a call can do without is resolved in _bind_kernels, the checks
+        # are inline (no helper frames) and the usual case is one kernel call.
+        if not self.started:
+            self._require_started()
+        if not self.time < t_end < math.inf:  # NaN fails too
             raise ModelError(f"cannot advance from t = {self.time!r} to t = {t_end!r}: "
                              "the end time must be finite and later than the current time")
         t0, dt = self._grid
         # Grid point at or just below t_end.  The tolerance absorbs masters that
         # accumulate time (t += h drifts by ~1e-10 over thousands of steps).
         target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
-        step = self.cnt.item(L.C_STEP)
+        step = self._grid_step()
         if target - step > self._step_budget:
-            todo = target - step
-            raise ModelError(
-                f"advancing from t = {self.time:g} to t = {t_end:g} takes {todo:.3g} internal steps of dt = {dt:g} "
-                f"with {self.integrator} (hours: ~{todo / 1e8 / 3600:.2g} h or more at 1e8 steps/s); one call may take "
-                f"at most {STEP_BUDGET_PER_CALL:.3g} steps so that a master is never held. Use shorter communication "
-                "steps, or a larger dt with implicit_contact (no contact stiffness limit), or event_driven (model A); "
-                "the state is kept.")
+            self._refuse_budget(t_end, target - step)
         while step < target:
             status = self._advance(target - step, self._track_energy)
-            if status < 0:
-                raise ModelError(self._kernel.message(status, t=self.time, t_end=t_end, dt=dt))
-            step = self.cnt.item(L.C_STEP)
-            if status > 0:  # a scene's guard stopped it: the frozen vertical motion hands over
-                self.time = float(t0 + step * dt)
-                self._observed = None
-                self._release_frozen_vertical()
+            if status:
+                self._stopped(status, t_end, step)
+            step = self._grid_step()
         self.time = float(t_end)
         self._observed = None
+
+    def _stopped(self, status: int, t_end: float, step: int) -> None:
+        """A kernel call that did not simply finish: a failure (the state is as it was
+        before the call) or a scene's guard handing the frozen vertical motion over."""
+        if status < 0:
+            raise ModelError(self._kernel.message(status, t=self.time, t_end=t_end, dt=self._grid[1]))
+        t0, dt = self._grid
+        self.time = float(t0 + self._grid_step() * dt)
+        self._observed = None
+        self._release_frozen_vertical()
+
+    def _refuse_budget(self, t_end: float, todo: int) -> None:
+        dt = self._grid[1]
+        raise ModelError(
+            f"advancing from t = {self.time:g} to t = {t_end:g} takes {todo:.3g} internal steps of dt = {dt:g} "
+            f"with {self.integrator} (hours: ~{todo / 1e8 / 3600:.2g} h or more at 1e8 steps/s); one call may take "
+            f"at most {STEP_BUDGET_PER_CALL:.3g} steps so that a master is never held. Use shorter communication "
+            "steps, or a larger dt with implicit_contact (no contact stiffness limit), or event_driven (model A); "
+            "the state is kept.")
 
     def _require_started(self) -> None:
         if not self.started:

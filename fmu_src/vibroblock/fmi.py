@@ -28,12 +28,39 @@ from __future__ import annotations
 
 import math
 import sys
+import threading
 import traceback
+import weakref
 
 from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
 _NAMESPACES_RELEASED_BY_LOADER: list = []
+# A doStep's communication point may differ from the FMU's time by this much relative
+# (masters that compute k h instead of accumulating); the step then starts at the FMU's time.
+TIME_TOLERANCE = 1e-9
+
+# The native front end (build/fmi_status_shim.c) calls a slave's do_step itself, without
+# pythonfmu's per-call work (method lookup, argument tuple, log-queue scan): right after
+# pythonfmu has made a slave (fmi2Instantiate, fmi2Reset), on the same thread, it takes
+# the slave from here.  Weak, so that a slave made without that front end (a Python test)
+# is not kept alive; and the instance name and resource folder must be the ones the
+# front end passed to pythonfmu, so that such a slave is never taken for another FMU's.
+_MADE_ON_THREAD: dict = {}
+
+
+def _claim_slave(instance_name: str, resource_location: str):
+    """The slave made last on this thread if it is the instance named (once; else None)."""
+    made = _MADE_ON_THREAD.pop(threading.get_ident(), None)
+    slave = None if made is None else made()
+    if slave is None or slave.instance_name != instance_name:
+        return None
+    # The folder as pythonfmu 0.7.0 passes it to the slave: "%20" decoded, "file://" cut.
+    folder = resource_location.replace("%20", " ")
+    cut = folder.find("file://")
+    if cut >= 0:
+        folder = folder[:cut] + folder[cut + len("file://"):]
+    return slave if slave.resources == folder else None
 
 
 class FmuFacade(Fmi2Slave):
@@ -49,6 +76,7 @@ class FmuFacade(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.start_time = 0.0
+        _MADE_ON_THREAD[threading.get_ident()] = weakref.ref(self)
 
     # ------------------------------------------------------------------ hooks
     def _is_started(self) -> bool:
@@ -119,13 +147,21 @@ class FmuFacade(Fmi2Slave):
         if not 0.0 < step_size < math.inf:  # NaN fails too
             raise self.rejected[0](f"communication step size {step_size!r} must be a finite number > 0")
         now = self._time()
-        if not abs(current_time - now) <= 1e-9 * max(1.0, abs(now)):  # NaN and infinities fail too
+        if not abs(current_time - now) <= TIME_TOLERANCE * max(1.0, abs(now)):  # NaN and infinities fail too
             raise self.rejected[0](f"communication point {current_time!r} differs from the FMU's time {now!r}; "
                                    "to go back in time restore an FMU state first")
         return now + step_size
 
     def terminate(self):
         pass
+
+    def _take_log(self) -> list:
+        """The queued log messages as (status, category, text), taken off the queue.  The
+        native front end's doStep bypasses pythonfmu, which would otherwise pass them on;
+        the queue is emptied in place because pythonfmu holds the list itself."""
+        messages = [(int(m.status), m.category or "", str(m.msg)) for m in self.log_queue]
+        self.log_queue.clear()
+        return messages
 
     # ------------------------------------------------------------------ FMU state
     def _get_fmu_state(self):

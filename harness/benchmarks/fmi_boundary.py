@@ -12,7 +12,10 @@ Prints side by side:
    removed, i.e. numba compiling everything (about half a minute);
 2. at 1000 internal steps per doStep: time per doStep through the C master and fmpy
    against the bare core doing the same work, and time per output read after each step
-   (5 outputs read in one call).  Each figure is given as the mean over all doSteps and
+   (5 outputs read in one call), with the FMU's native front end calling the slave's
+   do_step directly (as shipped) and, for comparison, with every doStep through
+   pythonfmu's library (``VIBROBLOCK_PYTHONFMU_DOSTEP=1``), and fmpy's own cost of an
+   FMI call (timed on one that does not enter Python).  Each figure is given as the mean over all doSteps and
    as the mean of the quietest block of BLOCK doSteps: on a shared machine the load of
    other processes comes and goes, and the quietest blocks of the FMU and of the core
    compare the work itself.
@@ -38,6 +41,7 @@ DT = 4e-4
 PER_STEP = 1000
 OUTPUTS = ("x", "z", "vx", "vz", "friction_force")
 BLOCK = 100  # doSteps per block (the C master's BENCH_BLOCK)
+THROUGH_PYTHONFMU = "VIBROBLOCK_PYTHONFMU_DOSTEP"  # "1": the front end leaves doStep to pythonfmu
 
 FMPY_FIRST_STEP = textwrap.dedent("""
     import sys, time
@@ -72,9 +76,12 @@ def extract(fmu: Path, folder: Path, keep_kernels: bool = True) -> Path:
     return folder
 
 
-def child_env(cache: Path) -> dict:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON") and k != "VIBROBLOCK_PYTHON"}
+def child_env(cache: Path, through_pythonfmu: bool = False) -> dict:
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith("PYTHON") and k not in ("VIBROBLOCK_PYTHON", THROUGH_PYTHONFMU)}
     env["NUMBA_CACHE_DIR"] = str(cache)
+    if through_pythonfmu:
+        env[THROUGH_PYTHONFMU] = "1"
     return env
 
 
@@ -122,7 +129,28 @@ def bare_core_per_call(calls: int) -> tuple[tuple[float, float], float]:
     return (min(mean for mean, _ in runs), min(best for _, best in runs)), min(chunked() for _ in range(3))
 
 
-def fmpy_per_call(folder, md, calls: int) -> tuple[float, float]:
+def host_per_call(host, folder, md, vr, calls: int, env: dict) -> tuple[tuple[float, float], tuple[float, float]]:
+    done = subprocess.run([str(host), "bench", str(folder), "BlockA", md.guid, repr(PER_STEP * DT), str(calls),
+                           *[str(vr[name]) for name in OUTPUTS]], capture_output=True, text=True, env=env, check=True)
+    figures = {key: float(value) for key, value in (line.split() for line in done.stdout.splitlines())}
+    return ((figures["do_step_us"] * 1e-6, figures["do_step_us_quietest"] * 1e-6),
+            (figures["read_us_per_output"] * 1e-6, figures["read_us_per_output_quietest"] * 1e-6))
+
+
+def fmpy_per_call(folder, md, calls: int, through_pythonfmu: bool = False) -> tuple[float, float]:
+    # The front end reads the switch when the instance is made (getenv sees os.environ).
+    previous = os.environ.pop(THROUGH_PYTHONFMU, None)
+    if through_pythonfmu:
+        os.environ[THROUGH_PYTHONFMU] = "1"
+    try:
+        return _fmpy_per_call(folder, md, calls)
+    finally:
+        os.environ.pop(THROUGH_PYTHONFMU, None)
+        if previous is not None:
+            os.environ[THROUGH_PYTHONFMU] = previous
+
+
+def _fmpy_per_call(folder, md, calls: int) -> tuple[float, float]:
     from fmpy.fmi2 import FMU2Slave
 
     vr = {v.name: v.valueReference for v in md.modelVariables}
@@ -145,6 +173,22 @@ def fmpy_per_call(folder, md, calls: int) -> tuple[float, float]:
     slave.terminate()
     slave.freeInstance()
     return mean_and_quietest(steps), mean_and_quietest(reads, len(outputs))
+
+
+def fmpy_call_layer(folder, md, calls: int) -> tuple[float, float]:
+    """fmpy's own cost of an FMI call (ctypes, its status check), from an FMI call that
+    does not enter Python: fmi2SetDebugLogging (the front end and pythonfmu's C++ only)."""
+    from fmpy.fmi2 import FMU2Slave, fmi2False
+
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=str(folder), modelIdentifier="BlockA", instanceName="layer")
+    slave.instantiate()
+    times = []
+    for _ in range(calls):
+        t0 = time.perf_counter()
+        slave.fmi2SetDebugLogging(slave.component, fmi2False, 0, None)
+        times.append(time.perf_counter() - t0)
+    slave.freeInstance()
+    return mean_and_quietest(times)
 
 
 def mean_and_quietest(times: list, per: int = 1) -> tuple[float, float]:
@@ -184,13 +228,13 @@ def main(argv=None):
             print(f"   {label:34} {figures[0]:9.2f} {figures[1]:9.2f}")
 
         folder = extract(fmu, work / "x-boundary")
-        done = subprocess.run([str(host), "bench", str(folder), "BlockA", md.guid, repr(PER_STEP * DT),
-                               str(args.calls), *[str(vr[name]) for name in OUTPUTS]],
-                              capture_output=True, text=True, env=child_env(work / "cache-host-cold"), check=True)
-        figures = {key: float(value) for key, value in (line.split() for line in done.stdout.splitlines())}
-        host = ((figures["do_step_us"] * 1e-6, figures["do_step_us_quietest"] * 1e-6),
-                (figures["read_us_per_output"] * 1e-6, figures["read_us_per_output_quietest"] * 1e-6))
-        fmpy = fmpy_per_call(folder, md, args.calls)
+        cache = work / "cache-host-cold"
+        rows = [("C master -> FMU", host_per_call(host, folder, md, vr, args.calls, child_env(cache))),
+                ("fmpy -> FMU", fmpy_per_call(folder, md, args.calls)),
+                ("C master -> FMU, doStep via pythonfmu",
+                 host_per_call(host, folder, md, vr, args.calls, child_env(cache, through_pythonfmu=True))),
+                ("fmpy -> FMU, doStep via pythonfmu", fmpy_per_call(folder, md, args.calls, through_pythonfmu=True))]
+        layer = fmpy_call_layer(folder, md, args.calls)
         bare, chunked = bare_core_per_call(args.calls)
 
     print(f"\n2. cost of the FMI boundary at {PER_STEP} internal steps per doStep ({args.calls} doSteps), BlockA;")
@@ -200,9 +244,13 @@ def main(argv=None):
     print(f"   {'bare core, one call per block':38} {bare[0] * 1e6:10.2f} {1.0:8.2f} {'-':>15} | "
           f"{bare[1] * 1e6:10.2f} {1.0:8.2f} {'-':>15}")
     print(f"   {'bare core, a Python call per doStep':38} {chunked * 1e6:10.2f} {chunked / bare[0]:8.2f} {'-':>15} |")
-    for label, (step, read) in (("C master -> FMU", host), ("fmpy -> FMU", fmpy)):
+    for label, (step, read) in rows:
         print(f"   {label:38} {step[0] * 1e6:10.2f} {step[0] / bare[0]:8.2f} {read[0] * 1e6:15.2f} | "
               f"{step[1] * 1e6:10.2f} {step[1] / bare[1]:8.2f} {read[1] * 1e6:15.2f}")
+    print(f"   {'fmpy call layer alone (see below)':38} {layer[0] * 1e6:10.2f} {layer[0] / bare[0]:8.2f} {'-':>15} | "
+          f"{layer[1] * 1e6:10.2f} {layer[1] / bare[1]:8.2f} {'-':>15}")
+    print("   fmpy call layer: fmpy's own cost of one FMI call (ctypes, its status check), timed on "
+          "fmi2SetDebugLogging,\n   which does not enter Python; every fmpy doStep pays it on top of the C master's.")
 
 
 if __name__ == "__main__":

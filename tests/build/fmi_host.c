@@ -285,6 +285,9 @@ static int check(int argc, char** argv)
     CHECK(fmu.fmi2DoStep(c, t, -1.0, 1) == ERROR, "negative step");
     CHECK(fmu.fmi2DoStep(c, t + 7.0, 0.5, 1) == ERROR, "wrong communication point");
     CHECK(errors_logged == before + 2, "each bad step logged an error");
+    double last = NAN;
+    CHECK(fmu.fmi2GetRealStatus(c, 2 /* fmi2LastSuccessfulTime */, &last) == OK && last == t,
+          "last successful time %a, the last step ended at %a", last, t);
     fmi2ValueReference outs[2] = {out, out};
     double pair[2];
     CHECK(fmu.fmi2GetReal(c, outs, 2, pair) == OK && pair[0] == first[9] && pair[1] == first[9], "state kept");

@@ -95,7 +95,7 @@ def as_values(md, settings):
     return args
 
 
-def host_run(host, fmus, name, settings, start, stop, step, drive=None):
+def host_run(host, fmus, name, settings, start, stop, step, drive=None, env=None):
     folder, md = fmus[name]
     args = ["run", folder, md.coSimulation.modelIdentifier, md.guid, repr(start), repr(stop), repr(step)]
     args += as_values(md, settings)
@@ -104,7 +104,7 @@ def host_run(host, fmus, name, settings, start, stop, step, drive=None):
     if drive is not None:
         by_name = {v.name: v.valueReference for v in md.modelVariables}
         args += ["-d", by_name["plate_z"], by_name["plate_v"], by_name["plate_a"], repr(drive[0]), repr(drive[1])]
-    done = run_host(host, *args)
+    done = run_host(host, *args, env=env)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     rows = [line.split() for line in done.stdout.splitlines()]
     table = np.array([[float.fromhex(x) if x.startswith(("0x", "-0x")) else float(x) for x in row] for row in rows])
@@ -187,6 +187,19 @@ def test_blocks_give_fmpys_bits(host, fmus, name, case):
     assert_same_bits(ours, reference)
     if case != "default":  # the case exercises the block: it moves
         assert np.ptp(ours[:, 2]) > 1e-3  # z
+
+
+@pytest.mark.parametrize("name", ["BlockA", "Excitation"])
+def test_do_steps_through_pythonfmu_give_the_same_bits(host, fmus, name):
+    """The front end calls the slave's do_step directly; left to pythonfmu
+    (VIBROBLOCK_PYTHONFMU_DOSTEP=1, for comparison) the run is the same."""
+    folder, md = fmus[name]
+    settings, drive = ({"A": 0.5, "omega": 0.8}, (0.2, 1.3)) if name == "BlockA" else ({}, None)
+    e = md.defaultExperiment
+    start, step = float(e.startTime), float(e.stepSize)
+    runs = [host_run(host, fmus, name, settings, start, start + 200 * step, step, drive, env)
+            for env in (None, clean_env(VIBROBLOCK_PYTHONFMU_DOSTEP="1"))]
+    assert_same_bits(runs[0], runs[1])
 
 
 @pytest.mark.parametrize("settings", [{}, {"mode": 1, "omega_start": 0.2, "omega_end": 2.0, "sweep_time": 50.0}])

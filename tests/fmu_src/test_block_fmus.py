@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
-from fmpy.fmi2 import FMU2Slave, fmi2Error, fmi2Integer, fmi2OK, fmi2ValueReference
+from fmpy.fmi2 import FMU2Slave, fmi2Error, fmi2Integer, fmi2LastSuccessfulTime, fmi2OK, fmi2ValueReference
 from fmpy.validation import validate_fmu
 
 from fmu_testing import do_step, fmu_log, set_real, status_of  # noqa: F401 (fixture)
@@ -194,6 +194,51 @@ def test_a_wrong_communication_point_gives_fmi2error(extracted, fmu_log):
         slave.doStep(0.0, 1.0)
         assert do_step(slave, 0.5, 1.0) == fmi2Error
         assert any("differs from the FMU's time" in message for *_, message in fmu_log.records)
+
+
+def test_do_step_goes_straight_to_the_slave_with_pythonfmus_bookkeeping(extracted, fmu_log):
+    """The native front end calls the facade's do_step itself, not through pythonfmu
+    (build/python_runtime.c): a refused step's message arrives once, with fmi2Error; the
+    last successful time is the end of the last step taken (pythonfmu's doStep would
+    record a refused step's start, so this also shows which way the steps went); after
+    fmi2Reset the new slave is the one stepped."""
+    with instance(extracted, "A", fmu_log, {"A": 0.4, "omega": 0.9}) as (slave, vr):
+        assert do_step(slave, 0.0, 1.0) == fmi2OK
+        assert slave.getRealStatus(fmi2LastSuccessfulTime) == 1.0
+        fmu_log.clear()
+        assert do_step(slave, 5.0, 1.0) == fmi2Error
+        assert [(status, "differs from the FMU's time" in message) for _, status, _, message in fmu_log.records] \
+            == [(fmi2Error, True)]
+        assert slave.getRealStatus(fmi2LastSuccessfulTime) == 1.0
+        fmu_log.clear()
+        first = reals(slave, vr)  # a call through pythonfmu: the message is not passed on again
+        assert do_step(slave, 1.0, 1.0) == fmi2OK and fmu_log.records == []
+        after_two = reals(slave, vr)
+
+        slave.reset()
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setReal([vr["A"], vr["omega"]], [0.4, 0.9])
+        slave.exitInitializationMode()
+        assert do_step(slave, 0.0, 1.0) == fmi2OK and reals(slave, vr) == first
+        assert do_step(slave, 1.0, 1.0) == fmi2OK and reals(slave, vr) == after_two
+        assert slave.getRealStatus(fmi2LastSuccessfulTime) == 2.0
+
+
+def test_do_steps_through_pythonfmu_give_the_same_bits(extracted, fmu_log, monkeypatch):
+    """VIBROBLOCK_PYTHONFMU_DOSTEP=1 leaves doStep to pythonfmu (for comparison): same bits."""
+    runs = []
+    for through_pythonfmu in (False, True):
+        if through_pythonfmu:
+            monkeypatch.setenv("VIBROBLOCK_PYTHONFMU_DOSTEP", "1")
+        with instance(extracted, "A", fmu_log, {"A": 0.8, "omega": 0.7, "initial_state": 2}) as (slave, vr):
+            rows = []
+            for k in range(40):
+                assert do_step(slave, k * 0.5, 0.5) == fmi2OK
+                rows.append(reals(slave, vr))
+            runs.append(np.array(rows))
+    assert runs[0].tobytes() == runs[1].tobytes()
+    assert np.ptp(runs[0][:, 1]) > 1e-3  # z moves: the run exercises the block
 
 
 def test_fixed_parameters_cannot_change_during_a_run(extracted, fmu_log):
