@@ -69,7 +69,12 @@ usable, <code>fmi2Instantiate</code> returns NULL and the log says what is missi
 <p>Compiled kernels: the FMU ships numba's compiled kernels for the CPU it was built on
 (<code>resources/vibroblock_kernels</code>); they are copied into the numba cache
 (<code>NUMBA_CACHE_DIR</code>, default <code>~/.cache/vibroblock/numba</code>) and recompiled only
-when numba, Python or the CPU differ (about half a minute, once).</p>"""
+when numba, Python or the CPU differ (about half a minute, once).</p>
+<p>In a non-Python host the binary calls the model's <code>do_step</code> itself for
+<code>fmi2DoStep</code> (the most frequent call; pythonfmu handles every other call on the
+same instance). Setting the environment variable <code>VIBROBLOCK_PYTHONFMU_DOSTEP=1</code>
+sends <code>fmi2DoStep</code> through pythonfmu as well (same results, about 0.4 &micro;s
+more per call).</p>"""
 
 
 def _e(text) -> str:
