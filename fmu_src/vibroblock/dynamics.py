@@ -54,6 +54,17 @@ def normal_force(penetration, u_n, prm):
 def contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     """Penetration, normal and tangential velocity relative to the plate, the tangent,
     and the normal contact force N (0 out of contact)."""
+    penetration, u_n, u_t, cos_a, sin_a, normal = surface_contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    if free_flight(kind) and not penetration > 0.0:  # a free particle: the fixed axes are its frame
+        return penetration, u_n, vx, 1.0, 0.0, 0.0
+    return penetration, u_n, u_t, cos_a, sin_a, normal
+
+
+@njit(inline="always")
+def surface_contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
+    """``contact`` on the surface under the block whatever the flight reading: with
+    ``flight = free`` off contact it still returns the surface's frame (u_t, cos a, sin a),
+    the frame of a contact phase continued across delta = 0 (the adaptive integrator's)."""
     height, slope = profile(kind, x, prm)
     if slope == 0.0:  # flat plate: skip the square root (model A's hot path)
         cos_a, sin_a = 1.0, 0.0
@@ -68,8 +79,6 @@ def contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     rel_vz = vz - plate_v
     u_n = rel_vz * cos_a - vx * sin_a
     u_t = vx * cos_a + rel_vz * sin_a
-    if free_flight(kind) and not penetration > 0.0:  # a free particle: the fixed axes are its frame
-        return penetration, u_n, vx, 1.0, 0.0, 0.0
     return penetration, u_n, u_t, cos_a, sin_a, normal_force(penetration, u_n, prm)
 
 

@@ -236,12 +236,10 @@ _RECORDS = (
                     "frozen tangent), not flight = 1 (free)" if r["flight"] == 1 else None)),
     Integrator(4, "adaptive", "error-controlled Rosenbrock (RODAS4) steps with located events, stiff-stable",
                models="*", force_evaluations=0, check_step=_tolerances, advance=adaptive.advance,
-               observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False,
-               unsupported_reading=lambda r: (
-                   "runs the default reading only (fixed axes, contact-force Coulomb bound, surface flight): its "
-                   "Jacobian, events and reset rule are written for it, not "
-                   + ", ".join(f"{name} = {value}" for name, value in r.items() if value)
-                   if any(r.values()) else None)),
+               observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False),
+    # adaptive runs every reading: the tangent frame through position_rates, the applied-load
+    # bound through coulomb_bound in its event values, free flight with one frame per regime
+    # (its module doc); tangent_frame + free flight is refused for every integrator (Settings).
 )
 INTEGRATOR_RECORDS: dict[str, Integrator] = {r.name: r for r in _RECORDS}
 BY_ID: dict[int, Integrator] = {r.id: r for r in _RECORDS}

@@ -1,4 +1,4 @@
-"""``adaptive`` (id 4, every model): error-controlled, stiff-stable steps with located events.
+"""``adaptive`` (id 4, every model and reading): error-controlled, stiff-stable steps with located events.
 
 Method.  A Rosenbrock method of order 4 with an embedded order-3 estimate (RODAS4,
 Hairer & Wanner, Solving ODEs II, Sec. IV.7: six stages, L-stable and stiffly
@@ -46,6 +46,24 @@ bracket is shorter than EVENT_TOL.  The state is restarted from the far end of t
 bracket -- the full-order step to within EVENT_TOL after the true zero, on the far side
 -- and the reset rule is applied there, not at a step's end.
 
+Readings (docs/physics.md; compile-time bits of ``kind``, so the default reading's
+kernels do the arithmetic they did before the others were covered).  The tangent frame
+moves the position slots at ``position_rates`` (dx/dt = u cos a, d zeta/dt = w) and phi
+integrates (dx/dt - V_d)^2 with that dx/dt; its contact, forces and energy rates are
+``dynamics``'s.  The Coulomb bound's N is ``coulomb_bound`` of the continued contact
+force, at the block's x and the time of the value (the applied load depends on both, so
+every event value is evaluated at its own time).  Free flight: ``dynamics.contact`` hands
+the forces the fixed axes and N = 0 at delta <= 0, a switch of frame at delta = 0.
+Inside a regime whose force is continued across delta = 0 that switch would be a kink
+(a jump of u_t, of the dashpot's and the load's directions) in the right-hand side that
+the Jacobian, the error estimate and the full steps of the event search straddle: the
+located landing or detachment would be where the step crossed the kink, not where delta
+crosses zero.  So each regime keeps one frame on both sides of delta = 0: the contact
+regimes the surface's (``dynamics.surface_contact``), the flight regime the fixed axes
+(u_t = vx, cos a = 1, sin a = 0); the frame switches only at the located event, with the
+regime.  The tangent frame with free flight is refused for every integrator (no position
+in the plane, docs/physics.md Sec. 6).
+
 Grid.  As ``event_driven``: dt only sets the grid on which the state is stored; a call
 integrates from t0 + n dt to t0 + (n + n_steps) dt.  Splits agree to the tolerances
 (the step sequence depends on where a run stops), not bit for bit.
@@ -56,12 +74,13 @@ import numpy as np
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import literally, njit
 
-from ..dynamics import contact, energy_rates, force, plate_motion
+from ..dynamics import contact, coulomb_bound, energy_rates, force, plate_motion, position_rates, surface_contact
 from .fixed_step import kahan_add, record_observation
 from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_PHASE_STEP, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
                       D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, P_ATOL, P_GN, P_KN, P_KT,
                       P_M, P_MUS, P_RTOL, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK,
                       Y_X, Y_Z)
+from ..readings import free_flight
 
 # Statuses (negative: failure, the arrays untouched).
 OK = 0
@@ -144,21 +163,26 @@ def _plate(drv, cnt, n0, u):
 def _rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
     """Rates of the state and the quadratures in one regime.  Within a contact phase the
     normal force k_n delta - gamma_n u_n is continued across delta = 0 (the event, not the
-    force, ends the phase), so a step may straddle a switch smoothly."""
+    force, ends the phase), so a step may straddle a switch smoothly.  Each regime keeps
+    one frame on both sides of delta = 0 for the same reason: a contact phase the surface's
+    (``surface_contact``), a flight with ``flight = free`` the fixed axes."""
     x, z, vx, vz = v[0], v[1], v[2], v[3]
     shear = v[4] if regime == LOADED else 0.0
-    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz, pv, prm)
+    pen, u_n, u_t, cos_a, sin_a, normal = surface_contact(kind, x, z, vx, vz, pz, pv, prm)
     if regime == FLIGHT:
         normal = 0.0
         gate = -1.0
+        if free_flight(kind):  # a free particle: the fixed axes are its frame (dynamics.contact)
+            u_t, cos_a, sin_a = vx, 1.0, 0.0
     else:
         normal = prm[P_KN] * pen - prm[P_GN] * u_n
         gate = 1.0
     fx, fz = force(kind, x, t, gate, normal, u_t, cos_a, sin_a, shear, prm)
     inv_m = 1.0 / prm[P_M]
-    out[0], out[1], out[2], out[3] = vx, vz, fx * inv_m, fz * inv_m
+    rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz); (u cos a, w) in the tangent frame
+    out[0], out[1], out[2], out[3] = rate_x, rate_z, fx * inv_m, fz * inv_m
     out[4] = u_t if regime == LOADED else 0.0
-    drift = vx - prm[P_VD]
+    drift = rate_x - prm[P_VD]
     out[5] = drift * drift
     if track_energy:
         # The rates are gated on delta > 0; within a contact phase they are continued like
@@ -172,10 +196,11 @@ def _rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
 
 
 @njit(inline="always")
-def _bound(kind, v, pz, pv, prm):
-    """Penetration and the Coulomb bound mu_s N (N continued across delta = 0)."""
-    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, v[0], v[1], v[2], v[3], pz, pv, prm)
-    return pen, prm[P_MUS] * (prm[P_KN] * pen - prm[P_GN] * u_n)
+def _bound(kind, v, t, pz, pv, prm):
+    """Penetration and the Coulomb bound mu_s N at time t: N the contact force continued
+    across delta = 0, or the applied load at the block's x and t (``coulomb_bound``)."""
+    pen, u_n, u_t, cos_a, sin_a, normal = surface_contact(kind, v[0], v[1], v[2], v[3], pz, pv, prm)
+    return pen, prm[P_MUS] * coulomb_bound(kind, prm[P_KN] * pen - prm[P_GN] * u_n, v[0], t, prm)
 
 
 @njit(inline="always")
@@ -216,8 +241,8 @@ def _event_at(regime, i):
 
 
 @njit(inline="always")
-def _value(kind, regime, i, v, pz, pv, prm):
-    pen, bound = _bound(kind, v, pz, pv, prm)
+def _value(kind, regime, i, v, t, pz, pv, prm):
+    pen, bound = _bound(kind, v, t, pz, pv, prm)
     return _event_value(_event_at(regime, i), pen, bound, prm[P_KT] * v[4])
 
 
@@ -277,7 +302,10 @@ def _solve(jac, c, lu, piv, r):
 
 
 # --------------------------------------------------------------------------- one step
-@njit(inline="always")
+# _linearise and _rosenbrock are compiled functions of their own, called from _evolve
+# rather than inlined (_rosenbrock has four call sites): the same arithmetic, their code
+# once per kind, and about a quarter of the compile time of each kind's kernels.
+@njit(cache=True)
 def _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, jac, ft, work):
     """f at the step's start, its Jacobian on the state block (central differences) and
     its explicit time derivative (a difference quotient over an exactly representable
@@ -317,7 +345,7 @@ def _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, j
         ft[i] = (plus[i] - minus[i]) * inv
 
 
-@njit(inline="always")
+@njit(cache=True)
 def _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, stage,
                 rate, out):
     """One RODAS4 step of length h from v (quadratures of v are 0): fills ``out`` with the
@@ -407,7 +435,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
 
     # The regime of the stored state, with the friction rule applied to it.
     pz, pv = _plate(drv, cnt, n0, 0.0)
-    pen, bound = _bound(kind, v, pz, pv, prm)
+    pen, bound = _bound(kind, v, t_base, pz, pv, prm)
     if pen > 0.0:
         if abs(kt * v[4]) >= bound:
             if v[4] != 0.0:
@@ -486,15 +514,15 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             pz, pv = _plate(drv, cnt, n0, u + s * h)
             earliest = math.inf
             for e in range(n_events):
-                if _value(kind, regime, e, probe, pz, pv, prm) < 0.0:
+                if _value(kind, regime, e, probe, t_base + (u + s * h), pz, pv, prm) < 0.0:
                     # the interpolant's root in (previous, s): a few regula falsi iterations
                     a, b = previous, s
                     _dense(v, trial, k, a, best)
                     pza, pva = _plate(drv, cnt, n0, u + a * h)
-                    ga = _value(kind, regime, e, best, pza, pva, prm)
+                    ga = _value(kind, regime, e, best, t_base + (u + a * h), pza, pva, prm)
                     if a == 0.0:
                         ga = max(ga, 0.0)
-                    gb = _value(kind, regime, e, probe, pz, pv, prm)
+                    gb = _value(kind, regime, e, probe, t_base + (u + s * h), pz, pv, prm)
                     root = b
                     if ga > 0.0:
                         for _ in range(40):
@@ -503,7 +531,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                                 root = 0.5 * (a + b)
                             _dense(v, trial, k, root, best)
                             pzr, pvr = _plate(drv, cnt, n0, u + root * h)
-                            gr = _value(kind, regime, e, best, pzr, pvr, prm)
+                            gr = _value(kind, regime, e, best, t_base + (u + root * h), pzr, pvr, prm)
                             if gr < 0.0:
                                 b, gb = root, gr
                                 ga *= 0.5
@@ -546,7 +574,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 e_index = e
         tol = max(EVENT_TOL, 4.0 * EPS * (abs(t_abs) + h))
         pz, pv = _plate(drv, cnt, n0, u)
-        lo, g_lo = 0.0, max(_value(kind, regime, e_index, v, pz, pv, prm), 0.0)
+        lo, g_lo = 0.0, max(_value(kind, regime, e_index, v, t_abs, pz, pv, prm), 0.0)
         hi, g_hi = -1.0, 0.0
         for attempt in range(3):
             length = s_hi * h if attempt == 0 else (s_sample * h if attempt == 1 else h)
@@ -559,7 +587,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, length, prm, track_energy, f0, jac, ft, lu,
                             piv, k, stage, rate, probe)
             pz, pv = _plate(drv, cnt, n0, u + length)
-            g = _value(kind, regime, e_index, probe, pz, pv, prm)
+            g = _value(kind, regime, e_index, probe, t_base + (u + length), pz, pv, prm)
             if g < 0.0:
                 hi, g_hi = length, g
                 for i in range(NV):
@@ -591,7 +619,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, guess, prm, track_energy, f0, jac, ft, lu, piv, k,
                         stage, rate, probe)
             pz, pv = _plate(drv, cnt, n0, u + guess)
-            g = _value(kind, regime, e_index, probe, pz, pv, prm)
+            g = _value(kind, regime, e_index, probe, t_base + (u + guess), pz, pv, prm)
             if g < 0.0:
                 hi, g_hi = guess, g
                 for i in range(NV):
@@ -624,7 +652,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         else:
             immediate = 0
         pz, pv = _plate(drv, cnt, n0, u)
-        pen, bound = _bound(kind, v, pz, pv, prm)
+        pen, bound = _bound(kind, v, t_base + u, pz, pv, prm)
         if event == EV_CONTACT:
             v[4] = 0.0
             regime = _regime_after_contact(bound)

@@ -39,10 +39,11 @@ def run(model, times, integrator="rk4", names=POINT, **settings):
 
 # ---------------------------------------------------------------- reduction to model A
 @pytest.mark.parametrize("combination", COMBINATIONS, ids=ids)
-@pytest.mark.parametrize("integrator", ["symplectic_euler", "rk4", "implicit_contact"])
+@pytest.mark.parametrize("integrator", ["symplectic_euler", "rk4", "implicit_contact", "adaptive"])
 def test_every_reading_reduces_exactly_to_model_a_on_a_flat_plate(integrator, combination):
     """A_x = 0 (and P_l = m g in C): B and C in any reading are model A with the same
-    Coulomb bound, bit for bit, through contacts, detachments and resets."""
+    Coulomb bound, bit for bit, through contacts, detachments and resets (adaptive: the
+    same error-controlled steps and located events, model A's own in every reading)."""
     opts = options(combination)
     if integrator == "implicit_contact" and (opts["formulation"] or opts["flight"]):
         pytest.skip("refused: test_implicit_contact_refuses_the_tangent_frame_and_free_flight")
