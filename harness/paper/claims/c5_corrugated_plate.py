@@ -36,7 +36,7 @@ def study_c5(runner: Runner) -> Study:
     items = [{"point": b_point(runner, res.b_horizon, OBSERVE_B, A=a, omega=omega),
               "extras": ["trace", "stick_roots"]} for a in res.b_amplitudes]
     items.append({"point": b_point(runner, res.b_horizon, OBSERVE_B, A=0.0, omega=omega, k_t=0.0),
-                  "extras": ["trace", "stick_roots"]})
+                  "extras": ["trace", "stick_roots", "stick_sites"]})
     results = runner.tasks(run_and_measure, items)
     runs = []
     for amplitude, result in zip(res.b_amplitudes, results):
@@ -63,7 +63,7 @@ def study_c5(runner: Runner) -> Study:
                 "initial": f"valley x = 3 pi/(2 omega_x) = {VALLEY:.1f}, steady orbit, spring relaxed at t0",
                 **observe_json(OBSERVE_B)}
     data = {"traces": [{"A": a, **r["trace"]} for a, r in zip(res.b_amplitudes, results)],
-            "frictionless_trace": frictionless["trace"]}
+            "frictionless_trace": frictionless["trace"], "frictionless_stick_sites": frictionless["stick_sites"]}
     return Study("C5", measured, settings, data)
 
 
@@ -83,24 +83,12 @@ def eq9_roots(drive: float, k_ratio: float, omega_x: float, low: float, high: fl
     return roots[stable].tolist(), roots[~stable].tolist()
 
 
-def stick_snapshots(time, x, count: int = 3) -> list[tuple[float, float]]:
-    """(t, x) in the middle of ``count`` separate stick phases of a trace (x nearly constant
-    between samples), spread over the trace; fewer if it has fewer sticks."""
-    time, x = np.asarray(time), np.asarray(x)
-    if len(time) < 3:
+def spread(sites: list, count: int = 3) -> list[tuple[float, float]]:
+    """``count`` of the (t, x) stick sites, spread over the run (first, last, between)."""
+    if not sites:
         return []
-    speed = np.abs(np.diff(x) / np.diff(time))
-    still = speed < 0.05 * (np.max(speed) if np.max(speed) > 0 else 1.0)
-    phases, start = [], None
-    for i, s in enumerate(np.append(still, False)):
-        if s and start is None:
-            start = i
-        elif not s and start is not None:
-            if i - start >= 3:
-                phases.append((start + i) // 2)
-            start = None
-    chosen = [phases[int(j)] for j in np.linspace(0, len(phases) - 1, min(count, len(phases)))] if phases else []
-    return [(float(time[i]), float(x[i])) for i in dict.fromkeys(chosen)]
+    chosen = dict.fromkeys(int(i) for i in np.linspace(0, len(sites) - 1, min(count, len(sites))))
+    return [(float(sites[i][0]), float(sites[i][1])) for i in chosen]
 
 
 def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
@@ -159,16 +147,19 @@ def draw(study: Study, save) -> None:
 
 
 def draw_fig4(study: Study, save) -> None:
-    """The paper's Fig. 4: the graphical solution of Eq. (9) at three times of the k_t = 0 run,
-    its stable (filled) and unstable (open) roots, and where the simulated block sticks."""
+    """The paper's Fig. 4: the graphical solution of Eq. (9) of the k_t = 0 run at the first and
+    the last stuck sample of its window and at its end, the stable (filled) and unstable
+    (open) roots at each time, and where the simulated block is then."""
     import matplotlib.pyplot as plt
 
     m = study.measured
     k_ratio, omega_x, v_d = m.get("eq9_slope", eq9_slope()), m.get("omega_x", OMEGA_X), m["V_d"]
-    trace = study.data["frictionless_trace"]
-    snapshots = stick_snapshots(trace["time"], trace["x"])
-    if not snapshots:
+    snapshots = spread(study.data.get("frictionless_stick_sites", []), 2)
+    if not snapshots:  # no stick in the window (or a study stored before sites were recorded)
         return
+    trace = study.data.get("frictionless_trace", {"time": []})
+    if trace["time"] and trace["time"][-1] > snapshots[-1][0]:  # and where the block is at the end
+        snapshots.append((float(trace["time"][-1]), float(trace["x"][-1])))
     low = min(x for _, x in snapshots) - 0.75 * m["wavelength"]
     high = max(x for _, x in snapshots) + 0.75 * m["wavelength"]
     grid = np.linspace(low, high, 2000)
@@ -182,7 +173,7 @@ def draw_fig4(study: Study, save) -> None:
         ax.plot(unstable, np.cos(omega_x * np.asarray(unstable)), "o", color=color, mfc="none", ms=6)
         ax.axvline(x, color=color, lw=2, alpha=0.5)
     ax.set(xlabel="x", ylabel="", title="Eq. (9), model B, $k_t$ = 0 (scaled drive): roots filled = stable, "
-           "open = unstable;\nvertical bars: where the simulated block sticks")
+           "open = unstable;\nvertical bars: the simulated block at the first and last stuck sample and at the end")
     ax.title.set_fontsize("small")
     ax.legend(fontsize="x-small", loc="lower left")
     save(fig, "fig4_eq9_roots.png")

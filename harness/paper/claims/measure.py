@@ -76,6 +76,8 @@ def run_and_measure(item: dict, pool) -> dict:
         result["trace"] = trace(ds)
     if "stick_roots" in extras:
         result.update(_stick_root_distances(ds, t, x, vx, v_d))
+    if "stick_sites" in extras:
+        result["stick_sites"] = stick_sites(t, x, vx, v_d)
     return result
 
 
@@ -106,6 +108,20 @@ def stable_roots_near(x: float, drive: float, k_ratio: float, omega_x: float = O
     if not len(roots):
         return math.nan
     return float(roots[np.argmin(np.abs(roots - x))])
+
+
+def stick_sites(t, x, vx, v_d, most: int = 50, min_run: int = 5) -> list[list[float]]:
+    """(t, x) of up to ``most`` stuck samples spread evenly over those of the window: samples
+    with |vx| < 0.2 |V_d| (the criterion of the Eq. (9) distances) in runs of at least
+    ``min_run`` consecutive ones, so that the turning points of an oscillation, where vx
+    passes zero, do not count.  Taken from every output sample, not from a thinned trace,
+    whose sampling can alias an oscillation into a seeming stick."""
+    slow = np.abs(np.asarray(vx)) < 0.2 * abs(v_d)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], slow.astype(np.int8), [0]])))
+    stuck = np.concatenate([np.arange(a, b) for a, b in zip(edges[::2], edges[1::2]) if b - a >= min_run]
+                           or [np.empty(0, dtype=int)])
+    chosen = stuck[np.unique(np.linspace(0, len(stuck) - 1, min(most, len(stuck))).astype(int))] if len(stuck) else []
+    return [[float(t[i]), float(x[i])] for i in chosen]
 
 
 def _stick_root_distances(ds, t, x, vx, v_d) -> dict:

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from harness.paper.claims.c5_corrugated_plate import draw_fig4, eq9_roots, eq9_slope, stick_snapshots
-from harness.paper.claims.measure import stable_roots_near
+from harness.paper.claims.c5_corrugated_plate import draw_fig4, eq9_roots, eq9_slope, spread
+from harness.paper.claims.measure import stable_roots_near, stick_sites
 from harness.paper.claims.study import Study
 
 
@@ -24,13 +24,18 @@ def test_eq9_roots_solve_the_equation_and_stable_ones_are_those_the_study_measur
     assert all(math.sin(omega_x * r) > 0 for r in unstable)
 
 
-def test_stick_snapshots_take_one_time_in_each_of_three_separate_sticks():
+def test_stick_sites_come_from_stuck_samples_and_three_are_spread_over_the_run():
     t = np.arange(0.0, 1000.0)
     x = np.interp(t, [0, 200, 250, 500, 550, 800, 850, 999], [0, 0, 50, 50, 100, 100, 150, 150])
-    snapshots = stick_snapshots(t, x)
-    assert [x for _, x in snapshots] == [0.0, 50.0, 150.0] or [x for _, x in snapshots] == [0.0, 100.0, 150.0]
-    assert len({x for _, x in snapshots}) == 3
-    assert stick_snapshots(t, 0.1 * t) == []  # no stick: nothing to draw on
+    # An oscillation sampled at its own period looks still in x, but its velocity is not small.
+    vx = np.gradient(x, t) + np.where((t > 500) & (t < 800), np.cos(t), 0.0)
+    sites = stick_sites(t, x, vx, v_d=0.01)
+    assert sites and all(abs(np.interp(ts, t, vx)) < 0.002 for ts, _ in sites)
+    assert not any(500 < ts < 800 for ts, _ in sites)
+    chosen = spread(sites)
+    assert [x for _, x in chosen] == [0.0, 50.0, 150.0] or len({x for _, x in chosen}) == 3
+    assert chosen[0][0] == sites[0][0] and chosen[-1][0] == sites[-1][0]
+    assert stick_sites(t, 0.1 * t, np.full_like(t, 0.1), v_d=0.01) == [] and spread([]) == []
 
 
 def test_fig4_is_drawn_from_the_k_t_zero_trace(tmp_path):
@@ -40,7 +45,7 @@ def test_fig4_is_drawn_from_the_k_t_zero_trace(tmp_path):
     t = np.arange(0.0, 1000.0)
     x = np.interp(t, [0, 300, 350, 999], [230, 230, 540, 540])
     study = Study("C5", {"V_d": 1e-2, "wavelength": 2 * math.pi / 0.02, "omega_x": 0.02, "eq9_slope": eq9_slope()},
-                  {}, {"frictionless_trace": {"time": t.tolist(), "x": x.tolist()}})
+                  {}, {"frictionless_stick_sites": stick_sites(t, x, np.gradient(x, t), v_d=1e-2)})
     saved = []
     draw_fig4(study, lambda fig, name: (fig.savefig(tmp_path / name), saved.append(name)))
     assert saved == ["fig4_eq9_roots.png"] and (tmp_path / "fig4_eq9_roots.png").stat().st_size > 10_000
