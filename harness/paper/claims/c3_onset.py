@@ -11,9 +11,7 @@ from __future__ import annotations
 
 from typing import Sequence
 
-import numpy as np
-
-from harness.paper.plots import regime_scatter
+from harness.paper.plots import regime_grid
 from harness.runs.bisection import Transition, refine
 from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
@@ -125,11 +123,7 @@ def draw(study: Study, save) -> None:
 
     d = study.data
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    omega, amplitude = np.meshgrid(d["omega"], d["A"])
-    regime_scatter(ax, omega.ravel(), amplitude.ravel(), np.asarray(d["regime"]).ravel())
-    line = np.geomspace(min(d["omega"]), max(d["omega"]), 300)
-    ax.plot(line, 1 / line**2, "k:", label=r"$A = g/\omega^2$")
-    ax.plot(line, onset_amplitude(line), "k-", lw=1, label=r"$A_c(\omega)$")
+    regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$")
     located = [(c["omega"], c["located_A"]) for c in study.measured["columns"] if c.get("located_A") is not None]
     if located:
         ax.plot(*zip(*located), "D", color="k", mfc="none", label="boundary (bisected)")

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from harness.paper.plots import regime_scatter
+from harness.paper.plots import regime_grid
 from harness.runs.bisection import Transition, refine
 from harness.runs.continuation import Ramp
 from harness.runs.settings import PointSettings
@@ -237,11 +237,8 @@ def draw(study: Study, save) -> None:
 
     d = study.data
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    omega, amplitude = np.meshgrid(d["omega"], d["A"])
-    regime_scatter(ax, omega.ravel(), amplitude.ravel(), np.asarray(d["regime"]).ravel())
-    line = np.geomspace(min(d["omega"]), max(d["omega"]), 300)
-    ax.plot(line, 1 / line**2, "k:", label=r"$A = P_l/(m\omega^2)$")
-    ax.plot(line, onset_amplitude(line), "k-", lw=1, label=r"$A_c(\omega)$ with $P_l$")
+    regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = P_l/(m\omega^2)$",
+                r"$A_c(\omega)$ with $P_l$")
     ax.axvline(study.measured["k_n_over_gamma_n"], color="tab:green", ls="--", label=r"$k_n/\gamma_n$")
     for key, marker, label in (("located_omega_1", "D", r"friction lost (bisected)"),
                                ("located_omega_2", "^", r"friction back (bisected)")):
