@@ -243,16 +243,16 @@ def run_libcosim(
     type, bad grid) and :class:`LibcosimError` when libcosim or the FMU fails.
     """
     name = re.sub(r"\W", "_", Path(fmu_path).stem) or "model"
-    wrapped = None
-    if inputs is not None:
-        def wrapped(t: float) -> dict[str, Value]:
-            return {f"{name}.{key}": value for key, value in _mapping(inputs(t), "inputs(t)").items()}
+
+    def prefixed(t: float) -> dict[str, Value]:  # the system's names are "<instance>.<variable>"
+        return {f"{name}.{key}": value for key, value in _mapping(inputs(t), "inputs(t)").items()}
+
     result = run_libcosim_system(
         {name: fmu_path},
         start_values={name: start_values or {}},
         outputs={name: outputs},
         stop_time=stop_time, step_size=step_size, start_time=start_time,
-        inputs=wrapped, timeout=timeout)
+        inputs=None if inputs is None else prefixed, timeout=timeout)
     return {key.split(".", 1)[1] if key != "time" else key: value for key, value in result.items()}
 
 
