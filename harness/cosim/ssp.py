@@ -377,10 +377,8 @@ def run_ssp_libcosim(path: str | os.PathLike, *, stop_time: float, step_size: fl
     layout of :func:`run_ssp_fmpy` (rows after each step; the start row is dropped).
     """
     import json
-    import subprocess
 
-    from harness.cosim.masters.errors import LibcosimError
-    from harness.cosim.masters.libcosim import _crash_message, _fmu_log_lines, _nanoseconds
+    from harness.cosim.masters.libcosim import _nanoseconds, run_worker
 
     n = _steps(start_time, stop_time, step_size)
     path = Path(path).resolve()
@@ -394,30 +392,8 @@ def run_ssp_libcosim(path: str | os.PathLike, *, stop_time: float, step_size: fl
     with tempfile.TemporaryDirectory(prefix="vibroblock-libcosim-ssp-") as tmp:
         work = Path(tmp)
         (work / "plan.json").write_text(json.dumps(plan))
-        (work / "tmp").mkdir()
-        env = dict(os.environ, TMPDIR=str(work / "tmp"), PYTHONUNBUFFERED="1")
-        root = Path(__file__).resolve().parents[2]
-        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(root), env.get("PYTHONPATH")]))
-        with open(work / "stdout.txt", "wb") as out, open(work / "stderr.txt", "wb") as err:
-            try:
-                proc = subprocess.run([sys.executable, "-m", "harness.cosim.ssp", "--libcosim-worker", str(work)],
-                                      stdout=out, stderr=err, env=env, timeout=timeout, check=False, cwd=root)
-            except subprocess.TimeoutExpired:
-                proc = None
-        stdout = (work / "stdout.txt").read_text(errors="replace")
-        stderr = (work / "stderr.txt").read_text(errors="replace")
-        fmu_log = _fmu_log_lines(stdout)
-        if proc is None:
-            raise LibcosimError(f"the libcosim run did not finish within {timeout} s and was stopped",
-                                fmu_log=fmu_log, console=stdout + stderr)
-        if proc.returncode != 0:
-            if (work / "error.json").is_file():
-                message = json.loads((work / "error.json").read_text())["message"]
-            else:
-                message = _crash_message(proc.returncode, stderr)
-            raise LibcosimError(message, fmu_log=fmu_log, console=stdout + stderr, returncode=proc.returncode)
-        with np.load(work / "result.npz") as data:
-            arrays = {key: data[key] for key in data.files}
+        arrays = run_worker(["-m", "harness.cosim.ssp", "--libcosim-worker", str(work)], work, timeout,
+                            cwd=Path(__file__).resolve().parents[2])
     out = {"time": start_time + np.arange(1, n + 1) * step_size}
     for component, name in plan["outputs"]:
         out[f"{component}.{name}"] = arrays[f"{component}.{name}"][1:]

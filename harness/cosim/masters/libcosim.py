@@ -410,30 +410,42 @@ def _execute(plan: dict, table: np.ndarray, timeout: float | None) -> dict[str, 
         work = Path(tmp)
         (work / "plan.json").write_text(json.dumps(plan))
         np.save(work / "inputs.npy", table)
-        (work / "tmp").mkdir()
-        env = dict(os.environ, TMPDIR=str(work / "tmp"), PYTHONUNBUFFERED="1")
-        with open(work / "stdout.txt", "wb") as out, open(work / "stderr.txt", "wb") as err:
-            try:
-                proc = subprocess.run([sys.executable, str(_WORKER), str(work)], stdout=out, stderr=err,
-                                      env=env, timeout=timeout, check=False)
-            except subprocess.TimeoutExpired:
-                proc = None
-        stdout = (work / "stdout.txt").read_text(errors="replace")
-        stderr = (work / "stderr.txt").read_text(errors="replace")
-        fmu_log = _fmu_log_lines(stdout)
-        if proc is None:
-            raise LibcosimError(f"the libcosim run did not finish within {timeout} s and was stopped",
-                                fmu_log=fmu_log, console=stdout + stderr)
-        if proc.returncode == 0:
-            for line in fmu_log:
-                _log.warning("FMU log (libcosim): %s", line)
-            with np.load(work / "result.npz") as data:
-                return {key: data[key] for key in data.files}
-        if proc.returncode == _EXIT_REPORTED and (work / "error.json").is_file():
-            message = json.loads((work / "error.json").read_text())["message"]
-        else:
-            message = _crash_message(proc.returncode, stderr)
-        raise LibcosimError(message, fmu_log=fmu_log, console=stdout + stderr, returncode=proc.returncode)
+        return run_worker([str(_WORKER), str(work)], work, timeout)
+
+
+def run_worker(arguments: list[str], work: Path, timeout: float | None, cwd: Path | None = None
+               ) -> dict[str, np.ndarray]:
+    """Run ``python arguments...``, a libcosim worker that reads its plan from ``work``, in a
+    child process (a crash or a hang of libcosim or an FMU cannot take this process with it),
+    its console captured in ``work``; the arrays it saved in ``work/result.npz``.  Raises
+    :class:`LibcosimError` with the worker's message (``error.json``, written before it exits
+    with ``_EXIT_REPORTED``), or how it crashed, or that it ran out of ``timeout``."""
+    (work / "tmp").mkdir(exist_ok=True)
+    env = dict(os.environ, TMPDIR=str(work / "tmp"), PYTHONUNBUFFERED="1")
+    if cwd is not None:  # a worker started as a module of this package (python -m ...)
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(cwd), env.get("PYTHONPATH")]))
+    with open(work / "stdout.txt", "wb") as out, open(work / "stderr.txt", "wb") as err:
+        try:
+            proc = subprocess.run([sys.executable, *arguments], stdout=out, stderr=err, env=env, timeout=timeout,
+                                  check=False, cwd=cwd)
+        except subprocess.TimeoutExpired:
+            proc = None
+    stdout = (work / "stdout.txt").read_text(errors="replace")
+    stderr = (work / "stderr.txt").read_text(errors="replace")
+    fmu_log = _fmu_log_lines(stdout)
+    if proc is None:
+        raise LibcosimError(f"the libcosim run did not finish within {timeout} s and was stopped",
+                            fmu_log=fmu_log, console=stdout + stderr)
+    if proc.returncode == 0:
+        for line in fmu_log:
+            _log.warning("FMU log (libcosim): %s", line)
+        with np.load(work / "result.npz") as data:
+            return {key: data[key] for key in data.files}
+    if proc.returncode == _EXIT_REPORTED and (work / "error.json").is_file():
+        message = json.loads((work / "error.json").read_text())["message"]
+    else:
+        message = _crash_message(proc.returncode, stderr)
+    raise LibcosimError(message, fmu_log=fmu_log, console=stdout + stderr, returncode=proc.returncode)
 
 
 def _crash_message(returncode: int, stderr: str) -> str:
