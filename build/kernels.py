@@ -1,14 +1,17 @@
 """Compiled kernels shipped inside the Block FMUs, so that a first doStep does not compile.
 
 Without them, the first ``doStep`` of a freshly installed FMU compiles the numba
-kernels of the physics core (about 25 s on a 2-core machine).  At build time a child
-process runs every model, integrator and scene option of the core once with an empty
-numba cache; the cache it leaves (index and data files, filed by the core's
+kernels of the physics core (about 25 s on a 2-core machine, ~45 s more for the
+adaptive integrator in a non-default reading).  At build time child processes, one per
+core, run every model, integrator, reading and scene option of the core once with an
+empty numba cache; the cache they leave (index and data files, filed by the core's
 content-addressed locator, ``vibroblock/jitcache.py``) is packed into the FMU as
 ``resources/vibroblock_kernels/``.  At run time the core copies these files into the
 host's numba cache where it has none yet, and numba uses them if they match the
 host: the same numba and Python versions and the same CPU (name and features).
-Otherwise it compiles as before and keeps its own copy.
+Otherwise it compiles as before and keeps its own copy.  The build also seeds the
+build machine's own cache (``NUMBA_CACHE_DIR``) with them, so the harness and the
+tests, which run the same core, do not compile them again.
 
 The compiled set is kept in ``build/work/kernels-<key>`` with a key of everything it
 depends on (core sources, Python, numba, llvmlite, CPU), so rebuilding an FMU reuses
@@ -28,24 +31,57 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 WORK_DIR = HERE / "work"
 ARCHIVE_FOLDER = "resources/vibroblock_kernels"
+# Children compiling kernels side by side (one per core, as numba compiles on one).
+MAX_CHILDREN = 8
 
-# Runs in a child process with the core's parent folder on sys.path and an empty
-# NUMBA_CACHE_DIR.  Every configuration a master can choose goes through the same
-# calls an FMU makes (start, inputs, advance, outputs, state); a configuration the
-# core refuses is skipped.
+# Runs in child processes with the core's parent folder on sys.path and one shared,
+# initially empty NUMBA_CACHE_DIR.  Every configuration a master can choose goes
+# through the same calls an FMU makes (start, inputs, advance, outputs, state): every
+# model, integrator and scene option in the default reading, and every model and
+# integrator in each other reading of the paper (vibroblock.readings: each is a
+# kernel of its own).  A configuration the core refuses is skipped.  The work is cut
+# into jobs that compile disjoint kernels (one model, reading and integrator each),
+# dealt out to `shares` children by their expected cost; child `share` runs its part.
 WARM_UP = r"""
 import itertools, sys
 import vibroblock
 from vibroblock import Block, INTEGRATORS, ModelError
 from vibroblock.models import VARIANTS, offered_by
-from vibroblock.parameters import SCENE_OPTIONS
+from vibroblock.parameters import READINGS, SCENE_OPTIONS
+
+share, shares = map(int, sys.argv[1:3])
+# Relative compile costs (adaptive RODAS4 kernels take ~45 s of CPU each, a
+# fixed-step scheme a few seconds), so that the children finish together.
+COST = {"adaptive": 10, "event_driven": 6, "implicit_contact": 3}
+
+jobs = []
+for model in VARIANTS:
+    names = [name for name, (models, _) in READINGS.items() if model in offered_by(models)]
+    for values in itertools.product((0, 1), repeat=len(names)):
+        reading = dict(zip(names, values))
+        for integrator in INTEGRATORS:
+            if any(values):
+                configs = [(reading, False, 0)]
+            else:
+                scenes = [{}] + [{name: True} for name, (models, _) in SCENE_OPTIONS.items()
+                                 if model in offered_by(models)]
+                configs = [(scene, energy, initial) for energy, scene, initial
+                           in itertools.product((False, True), scenes, (0, 2))]
+            jobs.append((COST.get(integrator, 2) * (1 if any(values) else 3), model, integrator, configs))
+
+load = [0] * shares
+mine = []
+for cost, model, integrator, configs in sorted(jobs, key=lambda job: -job[0]):
+    child = load.index(min(load))
+    load[child] += cost
+    if child == share:
+        mine.append((model, integrator, configs))
 
 done = refused = 0
-for model in VARIANTS:
-    scenes = [{}] + [{name: True} for name, (models, _) in SCENE_OPTIONS.items() if model in offered_by(models)]
-    for integrator, energy, scene, initial in itertools.product(INTEGRATORS, (False, True), scenes, (0, 2)):
+for model, integrator, configs in mine:
+    for options, energy, initial in configs:
         try:
-            block = Block(model, integrator, initial, energy, A=0.3, omega=0.5, **scene)
+            block = Block(model, integrator, initial, energy, A=0.3, omega=0.5, **options)
             block.start(0.0)
             block.advance_to(1.0)
             block.set_plate_input(0.01, 0.0, 0.0)
@@ -55,8 +91,8 @@ for model in VARIANTS:
             done += 1
         except ModelError:
             refused += 1
-print(f"warmed up {done} configurations ({refused} refused)")
-if done == 0:
+print(f"share {share}/{shares}: warmed up {done} configurations ({refused} refused)")
+if done == 0 and mine:
     sys.exit("no configuration could be run")
 """
 
@@ -94,10 +130,21 @@ def compile_kernels(core: Path) -> Path:
     try:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(scratch / "cache"), PYTHONPATH=str(core.parent))
         env.pop("NUMBA_DISABLE_JIT", None)
-        done = subprocess.run([sys.executable, "-c", WARM_UP], env=env, cwd=scratch,
-                              capture_output=True, text=True, timeout=1800)
-        if done.returncode != 0:
-            raise RuntimeError(f"compiling the kernels failed:\n{done.stdout}\n{done.stderr[-4000:]}")
+        shares = max(1, min(os.cpu_count() or 1, MAX_CHILDREN))
+        children = [subprocess.Popen([sys.executable, "-c", WARM_UP, str(share), str(shares)], env=env,
+                                     cwd=scratch, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                    for share in range(shares)]
+        failures = []
+        for child in children:
+            try:
+                out, err = child.communicate(timeout=3600)
+            except subprocess.TimeoutExpired:
+                child.kill()
+                out, err = child.communicate()
+            if child.returncode != 0:
+                failures.append(f"{out}\n{err[-4000:]}")
+        if failures:
+            raise RuntimeError("compiling the kernels failed:\n" + "\n".join(failures))
         os.replace(scratch / "cache", target)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
@@ -112,3 +159,14 @@ def archive_members(core: Path) -> dict[str, bytes]:
     folder = compile_kernels(core)
     return {f"{ARCHIVE_FOLDER}/{path.relative_to(folder).as_posix()}": path.read_bytes()
             for path in sorted(folder.rglob("*")) if path.is_file() and path.suffix in (".nbi", ".nbc")}
+
+
+def seed_host_cache(core: Path) -> None:
+    """Copy the kernels compiled for the core at ``core`` into this machine's numba cache
+    (``NUMBA_CACHE_DIR``, else the core's default folder) for every function it has none
+    for, with the core's own seeding, as an FMU does when it starts."""
+    folder = compile_kernels(core)
+    env = dict(os.environ, PYTHONPATH=str(core.parent))
+    env.pop("NUMBA_DISABLE_JIT", None)
+    subprocess.run([sys.executable, "-c", "import sys; from pathlib import Path; from vibroblock import jitcache; "
+                    "jitcache.seed_cache(Path(sys.argv[1]))", str(folder)], env=env, check=True, timeout=600)
