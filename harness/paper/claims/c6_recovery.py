@@ -10,7 +10,16 @@ bracket where nothing was located).  C6c: every row that loses friction regains 
 located omega_2 lies within ``RECOVERY_SLACK`` of k_n/gamma_n (the paper says "about"),
 and the rows' omega_2 agree within UNCHANGED_TOLERANCE of their mean ("independent of
 A").  C6d: at each k_n/gamma_n, omega_2 (in units of k_n/gamma_n) spreads over at most
-one grid step across k_n.  C6e: up and down ramps regain friction at the same omega."""
+one grid step across k_n.  C6e: up and down ramps regain friction at the same omega.
+
+Start phases and horizon: the diagram's points start on a crest and their window sees a
+quarter of a corrugation wavelength of drive travel.  In the default reading, both sides
+of the located omega_1 and omega_2 of the lowest A row are run again from four start
+phases (crest, descending flank, valley, ascending flank) over
+``Resolution.ensemble_wavelengths`` wavelengths (3 by default); where a side's class
+(friction held or not) differs between starts or from the diagram's, the located
+boundary is not a property of the model at this horizon and C6b/C6c say "not
+reproduced" with the regimes found, whatever the formula comparison gave."""
 from __future__ import annotations
 
 import math
@@ -23,10 +32,10 @@ from harness.runs.continuation import Ramp
 from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
 
-from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, c_run, friction_held, observe_json, onset_amplitude,
-                      onset_omega, ramp_task, recovery, run_and_measure)
+from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, c_run, ensemble_agrees, friction_held, observe_json,
+                      onset_amplitude, onset_omega, ramp_task, recovery, run_and_measure, start_ensemble)
 from .study import Claim, Runner, Study
-from .readings import READINGS
+from .readings import DEFAULT_READING, READINGS
 from .verdicts import (AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, combine,
                        fmt, relative)
 
@@ -73,6 +82,8 @@ def study_c6(runner: Runner) -> Study:
                      "first_transition_paper": math.sqrt(1.0 / float(amplitude)),
                      "first_transition_onset": onset_omega(float(amplitude), 0.07)})
     _locate_transitions(runner, base, rows)
+    ensemble = (_check_by_start_ensemble(runner, rows, res.ensemble_wavelengths)
+                if res.ensemble_wavelengths > 0 and runner.reading == DEFAULT_READING else None)
 
     stiffness_amplitude = 0.5
     base_k = PointSettings(run=c_run(runner, res.c_horizon, A=stiffness_amplitude), observe=observe_c)
@@ -107,6 +118,7 @@ def study_c6(runner: Runner) -> Study:
         "ramp_up_omega_2": up_rec["omega_2"],
         "ramp_down_omega_2": min(down_friction_above) if down_friction_above else None,
         "ramp_up_regimes": [r for _, r in up], "ramp_down_regimes": [r for _, r in down],
+        "start_ensemble": ensemble,
     }
     settings = {"model": "C", "parameters": C_PARAMETERS, "horizon": res.c_horizon, "initial": C_START,
                 "ramp_step": res.c6_ramp_step, **observe_json(observe_c),
@@ -140,6 +152,63 @@ def _locate_transitions(runner: Runner, base: PointSettings, rows: list[dict]) -
                         f"located_{transition_name}_bracket": [t.lo, t.hi] if t else None})
 
 
+def _check_by_start_ensemble(runner: Runner, rows: list[dict], wavelengths: float) -> dict | None:
+    """Both sides of the located omega_1 and omega_2 of the lowest A row that has both,
+    run from the four start phases over ``wavelengths`` corrugation wavelengths: the
+    diagram's runs start on a crest and see a quarter of a wavelength, so a located
+    boundary stands only if each side keeps its class from every start over a long window."""
+    row = next((r for r in rows if r.get("located_omega_1_bracket") and r.get("located_omega_2_bracket")), None)
+    if row is None:
+        return None
+    sides = []
+    for transition, held_below in (("omega_1", True), ("omega_2", False)):
+        below, above = row[f"located_{transition}_bracket"]
+        sides += [(transition, "below", below, held_below), (transition, "above", above, not held_below)]
+    found = start_ensemble(runner, [{"A": row["A"], "omega": omega} for _, _, omega, _ in sides], wavelengths)
+    checks = [{"transition": transition, "side": side, "omega": omega, "held_expected": held, **entry,
+               "agrees": ensemble_agrees(entry, held)}
+              for (transition, side, omega, held), entry in zip(sides, found.pop("points"))]
+    return {"A": row["A"], **found, "checks": checks}
+
+
+def _ensemble_part(m: dict, transition: str) -> tuple[str, str] | None:
+    """(verdict, text) of the start-ensemble check of one located transition: not
+    reproduced when a side's class changes with the start or the longer window."""
+    ensemble = m.get("start_ensemble")
+    if not ensemble:
+        return None
+    checks = [c for c in ensemble["checks"] if c["transition"] == transition]
+    where = (f"both sides of the located {transition} at A = {ensemble['A']:g}, from {len(ensemble['starts'])} "
+             f"starts over {ensemble['wavelengths']:g} wavelengths")
+    failing = [c for c in checks if not c["agrees"]]
+    if not failing:
+        return AGREES, f"{where} keep their class"
+    detail = "; ".join(f"{c['side']} (w = {fmt(c['omega'])}, {'friction' if c['held_expected'] else 'sliding'} "
+                       "in the diagram): " + ", ".join(f"{name} {s['regime']}" for name, s in c["starts"].items())
+                       for c in failing)
+    return NOT_REPRODUCED, f"{where}: the class changes with the start or the window, so the diagram cannot locate it ({detail})"
+
+
+def _ensemble_measured(m: dict) -> str:
+    ensemble = m.get("start_ensemble")
+    if not ensemble:
+        return ""
+    return "; start ensemble at A = {:g} ({:g} wavelengths): ".format(ensemble["A"], ensemble["wavelengths"]) + ", ".join(
+        f"{c['transition']} {c['side']} w = {fmt(c['omega'])}: "
+        + "/".join(s["regime"] for s in c["starts"].values())
+        + (f" (phi {fmt(c['phi_range'][0])}-{fmt(c['phi_range'][1])})" if c["phi_range"] else "")
+        for c in ensemble["checks"])
+
+
+def _with_ensemble(verdict: str, reason: str, part: tuple[str, str] | None) -> tuple[str, str]:
+    """The verdict stands only where the start ensemble confirms the located boundary."""
+    if part is None:
+        return verdict, reason
+    if part[0] == NOT_REPRODUCED:
+        return NOT_REPRODUCED, f"{reason}; but {part[1]}"
+    return verdict, f"{reason}; {part[1]}"
+
+
 def _near(row: dict, line: float) -> bool:
     """``line`` agrees with the row's first transition: within FORMULA_TOLERANCE of the located
     omega_1, or (nothing located) inside the grid bracket."""
@@ -168,14 +237,16 @@ def verdict_c6(m: dict) -> list[Row]:
                          f"{fmt(r['omega_1'])}], located {fmt(r.get('located_omega_1'))} (sqrt(P_l/mA) = "
                          f"{r['first_transition_paper']:.3g}, A_c onset {fmt(r['first_transition_onset'])}), regained "
                          f"at {fmt(r['omega_2'])}, located {fmt(r.get('located_omega_2'))}" for r in diagram)
-    measured += f" (located to {m.get('resolution', BOUNDARY_RESOLUTION):.0%} in omega)"
+    measured += f" (located to {m.get('resolution', BOUNDARY_RESOLUTION):.0%} in omega)" + _ensemble_measured(m)
     if not losing:
         rows.append(Row("C6b", measured, NOT_REPRODUCED, "no row loses friction in the scanned omega range"))
     else:
         ok = [r for r in losing if _near(r, r["first_transition_paper"])]
-        rows.append(Row("C6b", measured, AGREES if len(ok) == len(losing) else DISAGREES,
-                        f"sqrt(P_l/mA) within {FORMULA_TOLERANCE:.0%} of the located loss (or inside its grid "
-                        f"bracket) in {len(ok)}/{len(losing)} rows that lose friction"))
+        verdict, reason = _with_ensemble(
+            AGREES if len(ok) == len(losing) else DISAGREES,
+            f"sqrt(P_l/mA) within {FORMULA_TOLERANCE:.0%} of the located loss (or inside its grid bracket) in "
+            f"{len(ok)}/{len(losing)} rows that lose friction", _ensemble_part(m, "omega_1"))
+        rows.append(Row("C6b", measured, verdict, reason))
 
     ratio = m["k_n_over_gamma_n"]
     recovered = [r for r in losing if r["omega_2"] is not None]
@@ -198,7 +269,7 @@ def verdict_c6(m: dict) -> list[Row]:
                   f"omega_2 within {RECOVERY_SLACK:.0%} of k_n/gamma_n in {len(near)}/{len(recovered)}"),
                  (AGREES if same else DISAGREES, f"omega_2 within {spread:.0%} of its mean over the rows "
                   f"(<= {UNCHANGED_TOLERANCE:.0%} counts as independent of A)")]
-        verdict, reason = combine(parts)
+        verdict, reason = _with_ensemble(*combine(parts), _ensemble_part(m, "omega_2"))
         rows.append(Row("C6c", measured, verdict, reason))
 
     by_ratio: dict[float, list] = {}

@@ -210,10 +210,50 @@ def b_point(runner: Runner, horizon: float, observe_settings: ObservableSettings
     return PointSettings(run=run, observe=observe_settings)
 
 
-def c_run(runner: Runner, horizon: float, **parameters) -> RunSettings:
+def c_run(runner: Runner, horizon: float, x_start: float = CREST, **parameters) -> RunSettings:
+    """A model C run on the paper's plate with the scaled drive, starting at ``x_start`` on the
+    steady orbit with the drive spring relaxed."""
     values = {**SCALED, **parameters}
-    return runner.run("C", parameters=values, horizon=horizon, initial=InitialCondition("steady_orbit", x_start=CREST),
-                      start_time=relaxed_start(CREST, values["V_d"]))
+    return runner.run("C", parameters=values, horizon=horizon, initial=InitialCondition("steady_orbit", x_start=x_start),
+                      start_time=relaxed_start(x_start, values["V_d"]))
+
+
+# Start phases on the corrugation Z = A_x sin(omega_x x), named along the drive's
+# direction (+x): the crest, the flank going down, the valley, the flank going up.
+START_PHASES = {"crest": CREST, "descending flank": math.pi / OMEGA_X, "valley": VALLEY,
+                "ascending flank": WAVELENGTH}
+
+
+def start_ensemble(runner: Runner, points: Sequence[dict], wavelengths: float) -> dict:
+    """Each point (model C parameters) run from every start phase of ``START_PHASES`` over a
+    window of ``wavelengths`` corrugation wavelengths of drive travel, after a transient
+    of half a wavelength: what a short run from one start classified, checked against
+    the horizon and the start.  Returns the settings and, per point, each start's regime,
+    phi, contact fraction and drift velocity, whether friction holds, and the spread."""
+    travel = WAVELENGTH / SCALED["V_d"]  # time for the drive to move one wavelength
+    observe_settings = ObservableSettings(transient=0.5 * travel)
+    horizon = float(math.ceil((0.5 + wavelengths) * travel))  # whole output intervals
+    items = [{"point": PointSettings(run=c_run(runner, horizon, x_start=x_start, **point), observe=observe_settings)}
+             for point in points for x_start in START_PHASES.values()]
+    results = iter(runner.tasks(run_and_measure, items))
+    out = []
+    for point in points:
+        starts = {}
+        for name in START_PHASES:
+            o = next(results)["observables"]
+            starts[name] = {"regime": o["regime"], "held": friction_held(o["regime"]), "phi": o["phi"],
+                            "contact_fraction": o["contact_fraction"], "drift_velocity": o["drift_velocity"]}
+        phis = [s["phi"] for s in starts.values() if s["phi"] is not None and math.isfinite(s["phi"])]
+        out.append({"parameters": dict(point), "starts": starts,
+                    "held": sorted({s["held"] for s in starts.values()}),
+                    "phi_range": [min(phis), max(phis)] if phis else None})
+    return {"wavelengths": wavelengths, "horizon": horizon, "transient": observe_settings.transient,
+            "starts": {name: x for name, x in START_PHASES.items()}, "points": out}
+
+
+def ensemble_agrees(entry: dict, held: bool) -> bool:
+    """Every start of an ensemble point classified as ``held`` (friction) or not."""
+    return entry["held"] == [held]
 
 
 C_START = f"crest x = pi/(2 omega_x) = {CREST:.1f}, steady orbit, spring relaxed at t0"

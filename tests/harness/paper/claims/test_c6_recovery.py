@@ -8,7 +8,7 @@ import pytest
 from harness.paper.claims import c6_recovery
 from harness.paper.claims.c6_recovery import BOUNDARY_RESOLUTION, RECOVERY_SLACK, verdict_c6
 from harness.paper.claims.measure import recovery
-from harness.paper.claims.verdicts import AGREES, DISAGREES
+from harness.paper.claims.verdicts import AGREES, DISAGREES, NOT_REPRODUCED
 from harness.runs.settings import PointSettings, RunSettings
 
 
@@ -74,3 +74,72 @@ def test_recovery_is_judged_on_located_values_near_k_n_over_gamma_n_and_alike_ac
     far = [row(0.3, 3.0, 30.0, located_2=ratio * (1 + 2 * RECOVERY_SLACK)), row(3.0, 1.0, 30.0, located_2=ratio)]
     c6c = {r.claim: r for r in verdict_c6(measured(far))}["C6c"]
     assert c6c.verdict == DISAGREES and "within 25% of k_n/gamma_n in 1/2" in c6c.reason
+
+
+# ------------------------------------------------------------ the start-phase ensemble
+def test_the_start_phases_are_the_crest_both_flanks_and_the_valley():
+    from harness.paper.claims.measure import OMEGA_X, START_PHASES
+    height = {name: math.sin(OMEGA_X * x) for name, x in START_PHASES.items()}
+    slope = {name: math.cos(OMEGA_X * x) for name, x in START_PHASES.items()}
+    assert height["crest"] == pytest.approx(1) and height["valley"] == pytest.approx(-1)
+    # Flanks at mid height, the surface going down then up along the drive (+x).
+    assert height["descending flank"] == pytest.approx(0, abs=1e-12) and slope["descending flank"] == pytest.approx(-1)
+    assert height["ascending flank"] == pytest.approx(0, abs=1e-12) and slope["ascending flank"] == pytest.approx(1)
+
+
+class StartDependent(Regimes):
+    """Regimes from known boundaries, except that ``slides_from`` (a start x) slides everywhere."""
+
+    def __init__(self, loss, back, slides_from=None):
+        super().__init__(loss, back)
+        self.slides_from, self.runs = slides_from, []
+
+    def run(self, model, **fields):
+        return RunSettings(**fields)
+
+    def tasks(self, function, items):
+        self.runs += [i["point"] for i in items]
+        out = []
+        for i in items:
+            run = i["point"].run
+            regime = ("sliding" if run.initial.x_start == self.slides_from else
+                      self.regime(float(run.parameters["A"]), float(run.parameters["omega"])))
+            out.append({"observables": {"regime": regime, "phi": 1.0, "contact_fraction": 1.0, "drift_velocity": 0.0}})
+        return out
+
+
+def _located_rows(runner, omegas=(0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)):
+    rows = [{"A": 0.3, **recovery(list(omegas), [runner.regime(0.3, w) for w in omegas])}]
+    c6_recovery._locate_transitions(runner, PointSettings(run=RunSettings(parameters={"A": 0.0, "omega": 1.0})), rows)
+    return rows
+
+
+@pytest.mark.parametrize("slides_from", [None, "valley"])
+def test_both_sides_of_each_located_transition_are_rerun_from_four_starts_over_long_windows(slides_from):
+    from harness.paper.claims.measure import SCALED, START_PHASES, WAVELENGTH
+    loss, back = (lambda a: 1 / math.sqrt(a)), (lambda a: 14.0 + a)
+    runner = StartDependent(loss, back, START_PHASES.get(slides_from))
+    rows = _located_rows(runner)
+    runner.runs.clear()
+    ensemble = c6_recovery._check_by_start_ensemble(runner, rows, wavelengths=3.0)
+    travel = WAVELENGTH / SCALED["V_d"]
+    # 2 transitions x 2 sides x 4 starts, each with a 3-wavelength window after its transient.
+    assert len(runner.runs) == 16
+    assert {p.run.initial.x_start for p in runner.runs} == set(START_PHASES.values())
+    assert all(p.run.horizon - p.observe.transient >= 3.0 * travel for p in runner.runs)
+    assert all(p.run.start_time * SCALED["V_d"] == pytest.approx(p.run.initial.x_start) for p in runner.runs)
+    omegas = {(c["transition"], c["side"]): c["omega"] for c in ensemble["checks"]}
+    assert omegas[("omega_1", "below")] < loss(0.3) <= omegas[("omega_1", "above")]
+    assert omegas[("omega_2", "below")] < back(0.3) <= omegas[("omega_2", "above")]
+    # From the valley everything slides: the sides where the diagram holds friction fail.
+    failing = {(c["transition"], c["side"]) for c in ensemble["checks"] if not c["agrees"]}
+    assert failing == (set() if slides_from is None else {("omega_1", "below"), ("omega_2", "above")})
+
+    m = measured([{**rows[0], "first_transition_paper": loss(0.3), "first_transition_onset": None}])
+    m["start_ensemble"] = ensemble
+    verdicts = {r.claim: r for r in verdict_c6(m)}
+    if slides_from is None:
+        assert verdicts["C6b"].verdict == AGREES and "keep their class" in verdicts["C6b"].reason
+    else:
+        assert verdicts["C6b"].verdict == NOT_REPRODUCED and verdicts["C6c"].verdict == NOT_REPRODUCED
+        assert "valley sliding" in verdicts["C6b"].reason

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from harness.paper.claims.c8_drive_velocity import verdict_c8
-from harness.paper.claims.verdicts import AGREES, DISAGREES
+from harness.paper.claims.verdicts import AGREES, DISAGREES, NOT_REPRODUCED
 
 
 def test_c8_offset_sign():
@@ -19,3 +19,23 @@ def test_c8_offset_sign():
     assert verdict_c8(values(-20.5))[1].verdict == AGREES
     neither = verdict_c8(values(5.0))[1]
     assert neither.verdict == DISAGREES and "sign typo" not in neither.reason and "neither" in neither.reason
+
+
+def test_a_flying_block_is_not_sliding():
+    """At the printed A = 2e4 model C is thrown off the plate: flying points cannot carry
+    "sliding at any omega"; friction at the largest V_d contradicts it."""
+    def values(regimes_c, printed):
+        return {"omegas": [0.3, 3.0], "model_a": [{"V_d": 10.0, "regimes": ["sliding", "sliding"]}],
+                "model_c": [{"V_d": 1.0, "regimes": ["stick_slip", "stuck"]}, {"V_d": 10.0, "regimes": regimes_c}],
+                "model_c_printed": [{"V_d": 10.0, "regimes": printed}], "model_a_amplitude": 2.0,
+                "model_c_amplitude": 0.5, "model_c_printed_amplitude": 2e4,
+                "offsets": [{"V_d": 10.0, "x0": 30.0, "x0_std": 0.1, "force_balance": 30.0, "paper": -20.0,
+                             "regime": "sliding"}]}
+    sliding, _ = verdict_c8(values(["sliding", "sliding"], ["flying", "flying"]))
+    assert sliding.verdict == AGREES
+    assert "printed A = 20000 the block flies at 2/2 omegas" in sliding.reason
+    assert "C (A = 0.5): V_d = 1: 0/2 sliding" in sliding.measured
+    flying, _ = verdict_c8(values(["sliding", "flying"], ["flying", "flying"]))
+    assert flying.verdict == NOT_REPRODUCED and "w = 3 (flying)" in flying.reason
+    held, _ = verdict_c8(values(["stick_slip", "flying"], ["flying", "flying"]))
+    assert held.verdict == DISAGREES
