@@ -190,12 +190,8 @@ def main(argv=None) -> int:
         print(" ".join(fmu_names()))
         return 0
     args.dest.mkdir(parents=True, exist_ok=True)
-    names = args.names or fmu_names()
-    for name in names:
+    for name in args.names or fmu_names():
         print(f"built {build(name, args.dest, ship_kernels=not args.without_kernels)}")
-    if not args.without_kernels and any(name.startswith("Block") for name in names):
-        import kernels
-        kernels.seed_host_cache(CORE)  # the harness and the tests run the same core
     return 0
 
 

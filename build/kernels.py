@@ -9,9 +9,9 @@ content-addressed locator, ``vibroblock/jitcache.py``) is packed into the FMU as
 ``resources/vibroblock_kernels/``.  At run time the core copies these files into the
 host's numba cache where it has none yet, and numba uses them if they match the
 host: the same numba and Python versions and the same CPU (name and features).
-Otherwise it compiles as before and keeps its own copy.  The build also seeds the
-build machine's own cache (``NUMBA_CACHE_DIR``) with them, so the harness and the
-tests, which run the same core, do not compile them again.
+Otherwise it compiles as before and keeps its own copy.  A test session seeds its
+cache from the same folder (``tests/conftest.py``), so the tests, which run the same
+core, do not compile them again.
 
 The compiled set is kept in ``build/work/kernels-<key>`` with a key of everything it
 depends on (core sources, Python, numba, llvmlite, CPU), so rebuilding an FMU reuses
@@ -160,13 +160,3 @@ def archive_members(core: Path) -> dict[str, bytes]:
     return {f"{ARCHIVE_FOLDER}/{path.relative_to(folder).as_posix()}": path.read_bytes()
             for path in sorted(folder.rglob("*")) if path.is_file() and path.suffix in (".nbi", ".nbc")}
 
-
-def seed_host_cache(core: Path) -> None:
-    """Copy the kernels compiled for the core at ``core`` into this machine's numba cache
-    (``NUMBA_CACHE_DIR``, else the core's default folder) for every function it has none
-    for, with the core's own seeding, as an FMU does when it starts."""
-    folder = compile_kernels(core)
-    env = dict(os.environ, PYTHONPATH=str(core.parent))
-    env.pop("NUMBA_DISABLE_JIT", None)
-    subprocess.run([sys.executable, "-c", "import sys; from pathlib import Path; from vibroblock import jitcache; "
-                    "jitcache.seed_cache(Path(sys.argv[1]))", str(folder)], env=env, check=True, timeout=600)
