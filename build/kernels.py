@@ -159,4 +159,3 @@ def archive_members(core: Path) -> dict[str, bytes]:
     folder = compile_kernels(core)
     return {f"{ARCHIVE_FOLDER}/{path.relative_to(folder).as_posix()}": path.read_bytes()
             for path in sorted(folder.rglob("*")) if path.is_file() and path.suffix in (".nbi", ".nbc")}
-

@@ -186,14 +186,15 @@ def _ensemble_part(m: dict, transition: str) -> tuple[str, str] | None:
     detail = "; ".join(f"{c['side']} (w = {fmt(c['omega'])}, {'friction' if c['held_expected'] else 'sliding'} "
                        "in the diagram): " + ", ".join(f"{name} {s['regime']}" for name, s in c["starts"].items())
                        for c in failing)
-    return NOT_REPRODUCED, f"{where}: the class changes with the start or the window, so the diagram cannot locate it ({detail})"
+    return NOT_REPRODUCED, (f"{where}: the class changes with the start or the window, so the diagram cannot "
+                            f"locate it ({detail})")
 
 
 def _ensemble_measured(m: dict) -> str:
     ensemble = m.get("start_ensemble")
     if not ensemble:
         return ""
-    return "; start ensemble at A = {:g} ({:g} wavelengths): ".format(ensemble["A"], ensemble["wavelengths"]) + ", ".join(
+    return f"; start ensemble at A = {ensemble['A']:g} ({ensemble['wavelengths']:g} wavelengths): " + ", ".join(
         f"{c['transition']} {c['side']} w = {fmt(c['omega'])}: "
         + "/".join(s["regime"] for s in c["starts"].values())
         + (f" (phi {fmt(c['phi_range'][0])}-{fmt(c['phi_range'][1])})" if c["phi_range"] else "")

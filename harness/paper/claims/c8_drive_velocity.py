@@ -17,10 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from harness.paper.plots import regime_scatter
+from harness.runs.observables import FLYING, SLIDING
 from harness.runs.settings import InitialCondition, ObservableSettings, PointSettings
 from harness.runs.sweep import Axis, Grid
-
-from harness.runs.observables import FLYING, SLIDING
 
 from .measure import C_PARAMETERS, C_START, OBSERVE_A, OBSERVE_SHORT, SCALED, c_run, friction_held, observe_json, \
     run_and_measure
