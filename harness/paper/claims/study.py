@@ -64,7 +64,7 @@ class Resolution:
     c8_omegas: tuple
     # Window (corrugation wavelengths of drive travel) of the start-phase ensemble that
     # re-checks both sides of C6's located transitions from four starts; 0: no check
-    # (quick and tiny: 16 runs of >= 1.5 wavelengths would double quick's time).
+    # (quick and tiny: its 16 runs of >= 1.5 wavelengths, ~2 CPU-minutes, do not fit their budgets).
     ensemble_wavelengths: float = 3.0
     readings: bool = True      # measure C2, C5-C8 under every reading of the paper's equations
 
