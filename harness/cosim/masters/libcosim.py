@@ -94,7 +94,9 @@ __all__ = ["run_libcosim", "run_libcosim_system", "LibcosimError", "SetupError"]
 
 Value = float | int | bool
 _WORKER = Path(__file__).with_name("_libcosim_worker.py")
-_EXIT_REPORTED = 3  # the worker's status when it wrote error.json
+# The worker's EXIT_REPORTED (status when it wrote error.json), not imported from it:
+# importing the worker would load libcosimpy into this process.
+_EXIT_REPORTED = 3
 _TYPES = {"Real": "real", "Integer": "integer", "Boolean": "boolean"}
 _INT32 = (-(2**31), 2**31 - 1)
 _PYTHON_TYPES = {"real": "float or int", "integer": "32-bit int", "boolean": "bool"}

@@ -248,7 +248,7 @@ def start_ensemble(runner: Runner, points: Sequence[dict], wavelengths: float) -
                     "held": sorted({s["held"] for s in starts.values()}),
                     "phi_range": [min(phis), max(phis)] if phis else None})
     return {"wavelengths": wavelengths, "horizon": horizon, "transient": observe_settings.transient,
-            "starts": {name: x for name, x in START_PHASES.items()}, "points": out}
+            "starts": dict(START_PHASES), "points": out}
 
 
 def ensemble_agrees(entry: dict, held: bool) -> bool:
