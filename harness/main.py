@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from harness.paper.claims import RESOLUTIONS, Runner, run_studies, save_studies
-from harness.paper.claims.study import MODEL_A_INTEGRATOR
+from harness.paper.claims.study import CORRUGATED_INTEGRATION, CORRUGATED_TOLERANCES, MODEL_A_INTEGRATOR
 from harness.cosim.fmu import REPO_ROOT
 from harness.paper.report import timing_lines, write_report
 from harness.runs.sweep import INLINE, Execution, close_client, open_client
@@ -65,8 +65,9 @@ def main(argv: list[str] | None = None) -> Path:
     header = {"resolution": resolution.name, "points computed / reused from the store":
               f"{runner.points_computed} / {runner.points_reused}", "wall time": f"{elapsed:.0f} s",
               "integrators": f"model A {MODEL_A_INTEGRATOR} (symplectic_euler under the applied-load bound, which "
-                             "it does not offer), models B and C symplectic_euler, dt = 4e-4, unless a study says "
-                             "otherwise",
+                             f"it does not offer), models B and C {CORRUGATED_INTEGRATION.describe()} (adaptive: "
+                             + ", ".join(f"{k} {v:g}" for k, v in CORRUGATED_TOLERANCES.items())
+                             + "; symplectic_euler: dt = 4e-4), unless a study says otherwise",
               "measured values": "claims.json"}
     path = write_report(studies, out, (), header)
     for line in timing_lines(studies):

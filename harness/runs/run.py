@@ -37,7 +37,8 @@ def resolved_parameters(instance: FmuInstance, settings: RunSettings) -> dict[st
     """All FMU parameter values of a run: the FMU's defaults overridden by the settings."""
     instance.interface.require(settings.parameters, "parameter")
     try:
-        return {**instance.interface.defaults(), **instance.interface.typed(settings.fmu_values())}
+        defaults = instance.interface.defaults()
+        return {**defaults, **instance.interface.typed(settings.fmu_values(defaults))}
     except ValueError as exc:
         raise ValueError(f"{settings.fmu}: {exc}") from None
 
@@ -105,11 +106,12 @@ def run_attributes(instance: FmuInstance, settings: RunSettings, values: dict) -
     """Attributes describing a run completely (NetCDF-safe scalars and strings)."""
     # NetCDF has no boolean attributes: flags are stored as 0/1.
     # Switches given by name are stored as the FMU's values (their names as *_name).
+    integrator = settings.integrator_for(values)
     values = {name: instance.interface.encode(name, value) for name, value in values.items()}
     attrs = {name: int(value) if isinstance(value, bool) else value for name, value in values.items()}
     attrs.update({
         "fmu_path": settings.fmu, "fmu_sha256": instance.sha256, "model_name": instance.interface.model_name,
-        "integrator_name": settings.integration.integrator, "initial_condition": settings.initial.initial_state,
+        "integrator_name": integrator, "initial_condition": settings.initial.initial_state,
         "horizon": settings.horizon, "output_interval": settings.output_interval,
         "start_time": settings.start_time, "run_settings": canonical_json(settings),
         "initial_state_codes": json.dumps(instance.interface.choices("initial_state")),

@@ -100,17 +100,46 @@ class Parameters(Mapping):
 
 @dataclass(frozen=True)
 class Integration:
-    """The FMU's internal integrator and step."""
+    """The FMU's internal integrator and step, optionally switched by the plate frequency.
+
+    With ``switch_omega`` set, a run whose parameter ``omega`` exceeds it uses
+    ``integrator_above`` instead of ``integrator``: no integrator is the cheapest over the
+    whole frequency range (README, "Choosing speed or accuracy": ``adaptive`` spends its
+    steps on the plate's cycles, the fixed-step schemes on the contact's period), so a
+    sweep along omega can run each point with the cheaper one.  The choice is made per run
+    (:meth:`RunSettings.integrator`) and recorded with its results.
+    """
 
     integrator: str = "symplectic_euler"
     dt: float = 4e-4
+    switch_omega: float | None = None
+    integrator_above: str | None = None
 
     def __post_init__(self):
-        if not (isinstance(self.integrator, str) and self.integrator.isidentifier()):
-            raise ValueError(f"integrator {self.integrator!r} must be a name, e.g. 'symplectic_euler' (the FMU's "
-                             "description of its integrator parameter lists them)")
+        for name in (self.integrator, self.integrator_above or "unset"):
+            if not (isinstance(name, str) and name.isidentifier()):
+                raise ValueError(f"integrator {name!r} must be a name, e.g. 'symplectic_euler' (the FMU's "
+                                 "description of its integrator parameter lists them)")
         if not (math.isfinite(self.dt) and self.dt > 0):
             raise ValueError(f"dt = {self.dt!r} must be a finite number > 0")
+        if (self.switch_omega is None) != (self.integrator_above is None):
+            raise ValueError("switch_omega and integrator_above are given together (or neither)")
+        if self.switch_omega is not None and not (math.isfinite(self.switch_omega) and self.switch_omega > 0):
+            raise ValueError(f"switch_omega = {self.switch_omega!r} must be a finite number > 0")
+
+    def for_omega(self, omega: float | None) -> str:
+        """The integrator of a run at plate frequency ``omega``."""
+        if self.switch_omega is None:
+            return self.integrator
+        if omega is None:
+            raise ValueError(f"an integration switched at omega = {self.switch_omega:g} needs the run's omega "
+                             "among its parameters")
+        return self.integrator_above if omega > self.switch_omega else self.integrator
+
+    def describe(self) -> str:
+        if self.switch_omega is None:
+            return self.integrator
+        return f"{self.integrator} at omega <= {self.switch_omega:g}, {self.integrator_above} above"
 
 
 @dataclass(frozen=True)
@@ -181,10 +210,19 @@ class RunSettings:
         """Number of communication steps (the record has one more row: the start)."""
         return int(round(self.horizon / self.output_interval))
 
-    def fmu_values(self) -> dict[str, float | int]:
-        """Values to set on the FMU besides its defaults: parameters, integration, start."""
+    def integrator_for(self, defaults: Mapping | None = None) -> str:
+        """The integrator this run uses: its integration's choice at its omega (without an
+        omega of its own, the FMU's default one in ``defaults``)."""
+        return self.integration.for_omega(self.parameters.get("omega", (defaults or {}).get("omega")))
+
+    @property
+    def integrator(self) -> str:
+        return self.integrator_for()
+
+    def fmu_values(self, defaults: Mapping | None = None) -> dict[str, float | int]:
+        """Values to set on the FMU besides its ``defaults``: parameters, integration, start."""
         return {**dict(self.parameters), "dt": self.integration.dt,
-                "integrator": self.integration.integrator, **self.initial.fmu_values()}
+                "integrator": self.integrator_for(defaults), **self.initial.fmu_values()}
 
     def with_parameters(self, values: Mapping | None = None, **more: float) -> "RunSettings":
         return dataclasses.replace(self, parameters=self.parameters.updated(values, **more))

@@ -245,7 +245,7 @@ def point_inputs(point: PointSettings, sha256: str, interface: FmuInterface) -> 
     run = point.run
     return {
         "fmu_sha256": sha256, "model_name": interface.model_name,
-        "fmu_values": {**interface.defaults(), **run.fmu_values()},
+        "fmu_values": {**interface.defaults(), **run.fmu_values(interface.defaults())},
         "integration": to_jsonable(run.integration), "initial": to_jsonable(run.initial),
         "horizon": run.horizon, "output_interval": run.output_interval, "start_time": run.start_time,
         "observe": to_jsonable(point.observe), "observables_version": OBSERVABLES_VERSION,
@@ -525,13 +525,16 @@ def assemble(grid: Grid, points: Sequence[GridPoint], results: Mapping[str, dict
     data["stick_slip"] = (dims, columns["regime"].astype(str) == STICK_SLIP)
     coords = {a.name: (a.name, np.array(a.values)) for a in grid.axes}
     coords.update({name: (dims, values) for name, values in derived.items()})
-    resolved = {**interface.defaults(), **base.run.fmu_values()}
-    attrs = {name: int(value) if isinstance(value, bool) else value
-             for name, value in resolved.items() if name not in grid.names and name not in derived}
+    defaults = interface.defaults()
+    resolved = {**defaults, **base.run.fmu_values(defaults)}
+    # A switched integration is named by its rule, not by one point's choice.
+    switched = base.run.integration.switch_omega is not None
+    attrs = {name: int(value) if isinstance(value, bool) else value for name, value in resolved.items()
+             if name not in grid.names and name not in derived and not (switched and name == "integrator")}
     observe = base.observe
     attrs.update({
         "fmu_path": base.run.fmu, "fmu_sha256": sha256, "model_name": interface.model_name,
-        "integrator_name": base.run.integration.integrator, "initial_condition": base.run.initial.initial_state,
+        "integrator_name": base.run.integration.describe(), "initial_condition": base.run.initial.initial_state,
         "horizon": base.run.horizon, "output_interval": base.run.output_interval,
         "transient": observe.transient, "window": "rest of run" if observe.window is None else observe.window,
         "phi_threshold": observe.phi_threshold, "point_settings": canonical_json(base),

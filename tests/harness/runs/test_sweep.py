@@ -1,6 +1,7 @@
 """Sweeps: grids, equality with direct runs, worker-side FMU reuse."""
 from __future__ import annotations
 
+import dataclasses
 import os
 
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 
 from harness.runs.observables import MEASURED
 from harness.runs.run import run_point
-from harness.runs.settings import ObservableSettings, PointSettings, RunSettings
+from harness.runs.settings import Integration, ObservableSettings, PointSettings, RunSettings
 from harness.runs.sweep import (INLINE, Axis, Execution, Grid, SweepError, close_client, evaluate_expression, open_client,
                            points_of, run_sweep, worker_pool_loads)
 
@@ -49,6 +50,31 @@ def test_grid_with_a_derived_parameter_holds_the_ratio_fixed(fmu_a, tmp_path):
     np.testing.assert_allclose(ds.gamma_n.values, ds.k_n.values[:, None] / ds.ratio.values[None, :])
     with pytest.raises(ValueError, match="not a parameter"):
         points_of(Grid.parse(["stiffness=1,2"]), base)
+
+
+def test_an_integration_switched_by_omega_runs_each_point_with_its_own_integrator(fmu_a, tmp_path):
+    switched = Integration("event_driven", switch_omega=0.6, integrator_above="symplectic_euler")
+    base = base_point(fmu_a, horizon=200.0, transient=50.0)
+    base = dataclasses.replace(base, run=dataclasses.replace(base.run, integration=switched))
+    grid = Grid.parse(["omega=0.5,0.6,0.9"])
+    points = points_of(grid, base)
+    assert [p.inputs["fmu_values"]["integrator"] for p in points] == ["event_driven", "event_driven",
+                                                                      "symplectic_euler"]
+    ds = run_sweep(grid, base, tmp_path / "store", Execution(scheduler=INLINE, progress=False)).dataset
+    assert ds.attrs["integrator_name"] == switched.describe() and "integrator" not in ds.attrs
+    # Each point equals the run with its integrator named outright (which differs between them).
+    for point, integrator in zip(points, ("event_driven", "event_driven", "symplectic_euler")):
+        run = dataclasses.replace(point.settings.run, integration=Integration(integrator))
+        direct = run_point(dataclasses.replace(point.settings, run=run)).as_dict()
+        assert ds.phi.sel(omega=point.coordinates["omega"]).item() == direct["phi"]
+    other = run_point(dataclasses.replace(points[0].settings, run=dataclasses.replace(
+        points[0].settings.run, integration=Integration("symplectic_euler")))).as_dict()
+    assert other["phi"] != ds.phi.sel(omega=0.5).item()
+    # Without omega a switched run cannot choose, and says so.
+    with pytest.raises(ValueError, match="needs the run's omega"):
+        RunSettings(integration=switched).fmu_values()
+    with pytest.raises(ValueError, match="together"):
+        Integration("adaptive", switch_omega=1.0)
 
 
 def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a):

@@ -9,7 +9,7 @@ import pytest
 from harness.paper import report
 from harness.paper.claims import CLAIMS, READINGS, Runner, Study, run_studies, study_name
 from harness.paper.claims.readings import (A_READINGS, DEFAULT_READING, Reading, split_study_name)
-from harness.paper.claims.study import RESOLUTIONS
+from harness.paper.claims.study import CORRUGATED_TOLERANCES, RESOLUTIONS
 from harness.paper.claims.verdicts import AGREES, FLIPS, NOT_REPRODUCED
 
 
@@ -19,17 +19,21 @@ def runner(tmp_path, fmu_dir):
 
 
 def test_the_default_reading_sets_nothing_so_stored_points_keep_their_keys(runner):
+    # (Models B and C carry the adaptive integrator's tolerances: the runner's, not the reading's.)
     for model in "ABC":
-        assert dict(runner.run(model, parameters={"A": 1.0}).parameters) == {"A": 1.0}
+        expected = {"A": 1.0, **({} if model == "A" else CORRUGATED_TOLERANCES)}
+        assert dict(runner.run(model, parameters={"A": 1.0}).parameters) == expected
 
 
 def test_a_reading_sets_the_formulation_on_corrugated_models_only_and_never_overrides_a_study(runner):
     runner.reading = Reading(formulation=1, coulomb_normal=1)
     assert dict(runner.run("A").parameters) == {"coulomb_normal": 1.0}
     for model in "BC":
-        assert dict(runner.run(model).parameters) == {"formulation": 1.0, "coulomb_normal": 1.0}
+        assert dict(runner.run(model).parameters) == {"formulation": 1.0, "coulomb_normal": 1.0,
+                                                      **CORRUGATED_TOLERANCES}
     assert dict(runner.run("C", parameters={"formulation": 0.0}).parameters) == {"formulation": 0.0,
-                                                                                 "coulomb_normal": 1.0}
+                                                                                 "coulomb_normal": 1.0,
+                                                                                 **CORRUGATED_TOLERANCES}
 
 
 def test_study_names_round_trip():
@@ -58,7 +62,7 @@ def test_each_reading_runs_under_its_own_parameters(runner, monkeypatch):
     studies = run_studies(runner, ["C7"], progress=False)
     assert list(studies) == [study_name("C7", r) for r in READINGS]
     assert [s.reading for s in studies.values()] == [r.key for r in READINGS]
-    assert seen == [(r, r.parameters("B")) for r in READINGS]
+    assert seen == [(r, {**r.parameters("B"), **CORRUGATED_TOLERANCES}) for r in READINGS]
     assert runner.reading == DEFAULT_READING
     assert list(run_studies(runner, ["C7"], progress=False, readings=False)) == ["C7"]
     runner.resolution = dataclasses.replace(runner.resolution, readings=False)  # as --quick

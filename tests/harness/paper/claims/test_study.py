@@ -5,7 +5,7 @@ import pytest
 
 from harness.paper.claims import Runner
 from harness.paper.claims.readings import Reading
-from harness.paper.claims.study import MODEL_A_INTEGRATOR, RESOLUTIONS
+from harness.paper.claims.study import CORRUGATED_INTEGRATION, CORRUGATED_TOLERANCES, MODEL_A_INTEGRATOR, RESOLUTIONS
 from harness.runs.settings import Integration
 
 
@@ -23,8 +23,21 @@ def test_model_a_runs_exactly_where_the_event_driven_scheme_applies(runner):
     assert runner.run("A").integration == Integration("symplectic_euler")
 
 
-def test_a_study_s_own_integration_and_other_models_are_left_alone(runner):
+def test_a_study_s_own_integration_is_left_alone(runner):
     own = Integration("rk4", dt=1e-3)
-    assert runner.run("A", integration=own).integration == own
+    for model in "ABC":
+        run = runner.run(model, integration=own)
+        assert run.integration == own
+        assert "rtol" not in run.parameters
+
+
+def test_corrugated_models_run_adaptive_at_low_omega_and_the_paper_s_scheme_above(runner):
     for model in "BC":
-        assert runner.run(model).integration == Integration()
+        run = runner.run(model)
+        assert run.integration == CORRUGATED_INTEGRATION
+        assert {name: run.parameters[name] for name in CORRUGATED_TOLERANCES} == CORRUGATED_TOLERANCES
+        switch = CORRUGATED_INTEGRATION.switch_omega
+        assert run.with_parameters(omega=switch).fmu_values()["integrator"] == "adaptive"
+        assert run.with_parameters(omega=switch * 1.01).fmu_values()["integrator"] == "symplectic_euler"
+    # A study's own tolerance wins over the default one.
+    assert runner.run("C", parameters={"rtol": 1e-9}).parameters["rtol"] == 1e-9
