@@ -10,6 +10,8 @@ side by side in one process, through the FMU and the same measurement as the stu
 
 * model C, a row of the C6 diagram (horizon 1e4, from a crest with the drive spring
   relaxed) at A = 0.3 and 3 (``--full``: also A = 1 and 10, and ten omegas instead of six);
+* model C, C8's fast drive: V_d = 10 at A = 0.5, omega = 0.3 (``--full``: also V_d = 1,
+  and omega = 1);
 * model B, the C5 runs (horizon 1e5, omega = 0.5, from a valley) at A = 0 and 5
   (``--full``: A = 0, 1, 2.5, 5, 10 and k_t = 0).
 
@@ -35,10 +37,10 @@ EULER = Integration("symplectic_euler")
 ADAPTIVE = Integration("adaptive")
 
 
-def model_c_point(amplitude: float, omega: float) -> PointSettings:
+def model_c_point(amplitude: float, omega: float, v_d: float = SCALED["V_d"]) -> PointSettings:
     run = RunSettings(fmu=default_fmu("C"), horizon=10_000.0,
-                      parameters={**SCALED, **CORRUGATED_TOLERANCES, "A": amplitude, "omega": omega},
-                      initial=InitialCondition("steady_orbit", x_start=CREST), start_time=CREST / SCALED["V_d"])
+                      parameters={**SCALED, **CORRUGATED_TOLERANCES, "A": amplitude, "omega": omega, "V_d": v_d},
+                      initial=InitialCondition("steady_orbit", x_start=CREST), start_time=CREST / v_d)
     return PointSettings(run=run, observe=OBSERVE_SHORT)
 
 
@@ -58,27 +60,29 @@ def timed(point: PointSettings, integration: Integration) -> tuple[float, dict]:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--full", action="store_true", help="every row and omega (about 6 minutes)")
+    parser.add_argument("--full", action="store_true", help="every row and omega (about 8 minutes)")
     args = parser.parse_args(argv)
     omegas = np.round(np.geomspace(0.1, 50.0, 10), 4) if args.full else (0.1, 0.4, 1.5832, 3.1581, 12.5661, 50.0)
-    cases = [(f"C  A = {a:<4g} omega = {w:<7g}", model_c_point(a, float(w)), float(w))
+    cases = [(f"C  A = {a:<4g} omega = {w:<7g}", model_c_point(a, float(w)))
              for a in ((0.3, 1.0, 3.0, 10.0) if args.full else (0.3, 3.0)) for w in omegas]
+    cases += [(f"C  A = 0.5  omega = {w:<7g} V_d = {v:g}", model_c_point(0.5, w, v))
+              for v in ((1.0, 10.0) if args.full else (10.0,)) for w in ((0.3, 1.0) if args.full else (0.3,))]
     b_cases = [(a, {}) for a in ((0.0, 1.0, 2.5, 5.0, 10.0) if args.full else (0.0, 5.0))]
     b_cases += [(0.0, {"k_t": 0.0})] if args.full else []
     cases += [(f"B  A = {a:<4g} omega = 0.5 " + " ".join(f"{k} = {v:g}" for k, v in more.items()),
-               model_b_point(a, **more), 0.5) for a, more in b_cases]
-    print(f"{'run':36s} {'euler s':>8s} {'adaptive s':>10s} {'ratio':>6s}   euler regime, phi | adaptive regime, phi")
+               model_b_point(a, **more)) for a, more in b_cases]
+    print(f"{'run':44s} {'euler s':>8s} {'adaptive s':>10s} {'ratio':>6s}   euler regime, phi | adaptive regime, phi")
     totals = {"symplectic_euler": 0.0, "adaptive": 0.0, "switched": 0.0}
     disagreements = 0
-    for label, point, omega in cases:
+    for label, point in cases:
         t_euler, euler = timed(point, EULER)
         t_adaptive, adaptive = timed(point, ADAPTIVE)
         totals["symplectic_euler"] += t_euler
         totals["adaptive"] += t_adaptive
-        chosen = CORRUGATED_INTEGRATION.for_omega(omega)
+        chosen = CORRUGATED_INTEGRATION.for_values(point.run.parameters)
         totals["switched"] += t_adaptive if chosen == "adaptive" else t_euler
         disagreements += euler["regime"] != adaptive["regime"]
-        print(f"{label:36s} {t_euler:8.2f} {t_adaptive:10.2f} {t_euler / t_adaptive:6.2f}   "
+        print(f"{label:44s} {t_euler:8.2f} {t_adaptive:10.2f} {t_euler / t_adaptive:6.2f}   "
               f"{euler['regime']}, {euler['phi']:.4g} | {adaptive['regime']}, {adaptive['phi']:.4g}"
               f"   (switch: {chosen})", flush=True)
     print(f"\ntotal: symplectic_euler {totals['symplectic_euler']:.1f} s, adaptive {totals['adaptive']:.1f} s, "

@@ -100,46 +100,49 @@ class Parameters(Mapping):
 
 @dataclass(frozen=True)
 class Integration:
-    """The FMU's internal integrator and step, optionally switched by the plate frequency.
+    """The FMU's internal integrator and step, optionally switched by parameter values.
 
-    With ``switch_omega`` set, a run whose parameter ``omega`` exceeds it uses
-    ``integrator_above`` instead of ``integrator``: no integrator is the cheapest over the
-    whole frequency range (README, "Choosing speed or accuracy": ``adaptive`` spends its
-    steps on the plate's cycles, the fixed-step schemes on the contact's period), so a
-    sweep along omega can run each point with the cheaper one.  The choice is made per run
-    (:meth:`RunSettings.integrator`) and recorded with its results.
+    With ``switch`` (pairs of parameter name and limit), a run in which any of those
+    parameters exceeds its limit uses ``integrator_above`` instead of ``integrator``: no
+    integrator is the cheapest everywhere (README, "Choosing speed or accuracy":
+    ``adaptive`` spends its steps on the plate's cycles and on the surface's crests, the
+    fixed-step schemes on the contact's period), so a sweep can run each point with the
+    cheaper one.  The choice is made per run (:meth:`RunSettings.integrator_for`) and
+    recorded with its results.
     """
 
     integrator: str = "symplectic_euler"
     dt: float = 4e-4
-    switch_omega: float | None = None
+    switch: tuple = ()
     integrator_above: str | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "switch", tuple((str(name), float(limit)) for name, limit in self.switch))
         for name in (self.integrator, self.integrator_above or "unset"):
             if not (isinstance(name, str) and name.isidentifier()):
                 raise ValueError(f"integrator {name!r} must be a name, e.g. 'symplectic_euler' (the FMU's "
                                  "description of its integrator parameter lists them)")
         if not (math.isfinite(self.dt) and self.dt > 0):
             raise ValueError(f"dt = {self.dt!r} must be a finite number > 0")
-        if (self.switch_omega is None) != (self.integrator_above is None):
-            raise ValueError("switch_omega and integrator_above are given together (or neither)")
-        if self.switch_omega is not None and not (math.isfinite(self.switch_omega) and self.switch_omega > 0):
-            raise ValueError(f"switch_omega = {self.switch_omega!r} must be a finite number > 0")
+        if bool(self.switch) != (self.integrator_above is not None):
+            raise ValueError("switch and integrator_above are given together (or neither)")
+        for name, limit in self.switch:
+            if not math.isfinite(limit):
+                raise ValueError(f"the switch's limit on {name} = {limit!r} must be finite")
 
-    def for_omega(self, omega: float | None) -> str:
-        """The integrator of a run at plate frequency ``omega``."""
-        if self.switch_omega is None:
-            return self.integrator
-        if omega is None:
-            raise ValueError(f"an integration switched at omega = {self.switch_omega:g} needs the run's omega "
-                             "among its parameters")
-        return self.integrator_above if omega > self.switch_omega else self.integrator
+    def for_values(self, values: Mapping) -> str:
+        """The integrator of a run with these parameter values."""
+        missing = [name for name, _ in self.switch if name not in values]
+        if missing:
+            raise ValueError(f"an integration switched by {', '.join(missing)} needs the run's value of it")
+        above = any(values[name] > limit for name, limit in self.switch)
+        return self.integrator_above if above else self.integrator
 
     def describe(self) -> str:
-        if self.switch_omega is None:
+        if not self.switch:
             return self.integrator
-        return f"{self.integrator} at omega <= {self.switch_omega:g}, {self.integrator_above} above"
+        limits = " and ".join(f"{name} <= {limit:g}" for name, limit in self.switch)
+        return f"{self.integrator} at {limits}, {self.integrator_above} otherwise"
 
 
 @dataclass(frozen=True)
@@ -211,9 +214,9 @@ class RunSettings:
         return int(round(self.horizon / self.output_interval))
 
     def integrator_for(self, defaults: Mapping | None = None) -> str:
-        """The integrator this run uses: its integration's choice at its omega (without an
-        omega of its own, the FMU's default one in ``defaults``)."""
-        return self.integration.for_omega(self.parameters.get("omega", (defaults or {}).get("omega")))
+        """The integrator this run uses: its integration's choice at its parameter values
+        (a value it does not set is the FMU's default, from ``defaults``)."""
+        return self.integration.for_values({**dict(defaults or {}), **dict(self.parameters)})
 
     @property
     def integrator(self) -> str:

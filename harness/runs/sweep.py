@@ -528,7 +528,7 @@ def assemble(grid: Grid, points: Sequence[GridPoint], results: Mapping[str, dict
     defaults = interface.defaults()
     resolved = {**defaults, **base.run.fmu_values(defaults)}
     # A switched integration is named by its rule, not by one point's choice.
-    switched = base.run.integration.switch_omega is not None
+    switched = bool(base.run.integration.switch)
     attrs = {name: int(value) if isinstance(value, bool) else value for name, value in resolved.items()
              if name not in grid.names and name not in derived and not (switched and name == "integrator")}
     observe = base.observe

@@ -34,9 +34,10 @@ from .readings import DEFAULT_READING, Reading
 
 # Model A's integrator in the studies where it applies (see Runner.run).
 MODEL_A_INTEGRATOR = "event_driven"
-# Models B and C: ``adaptive`` up to CORRUGATED_SWITCH_OMEGA, the paper's scheme above
+# Models B and C: ``adaptive`` where it is the cheaper one, the paper's scheme elsewhere
 # (see Runner.run), with the adaptive integrator's tolerances.
-CORRUGATED_INTEGRATION = Integration("adaptive", switch_omega=2.0, integrator_above="symplectic_euler")
+CORRUGATED_INTEGRATION = Integration("adaptive", switch=(("omega", 2.0), ("V_d", 1.0)),
+                                     integrator_above="symplectic_euler")
 CORRUGATED_TOLERANCES = {"rtol": 1e-6, "atol": 1e-8}
 
 
@@ -149,12 +150,12 @@ class Runner:
         ~1e-9, and 2-5x cheaper than the paper's first-order scheme through the FMU) where
         it applies, i.e. under the contact-force bound, else with the paper's
         ``symplectic_euler`` at dt = 4e-4.  Models B and C run with ``adaptive`` (rtol
-        1e-6, atol 1e-8) at omega <= 2 and ``symplectic_euler`` above: on the studies'
-        runs (scaled drive, paper's plate) ``adaptive`` costs 3-6x less than the paper's
-        scheme at low omega, where a stick is long and the plate slow, and its cost grows
-        with the number of plate cycles, so that it costs more from omega ~ 2-3 on
-        (``python -m harness.benchmarks.study_integrators``); at the same regime on every
-        row measured, it is also the accurate one of the two."""
+        1e-6, atol 1e-8) at omega <= 2 and V_d <= 1, ``symplectic_euler`` otherwise: on
+        the studies' runs (paper's plate) ``adaptive`` costs 2-6x less than the paper's
+        scheme where the plate is slow and the drive is slow, and its cost grows with the
+        plate's cycles and the crests crossed, so that it costs more from omega ~ 2-3 on
+        and at V_d = 10 (``python -m harness.benchmarks.study_integrators``); with the
+        same regime on every run measured, it is also the accurate one of the two."""
         parameters = {**self.reading.parameters(model), **dict(fields.pop("parameters", {}) or {})}
         if "integration" not in fields:
             if model == "A" and not parameters.get("coulomb_normal"):

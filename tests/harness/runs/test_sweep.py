@@ -53,7 +53,7 @@ def test_grid_with_a_derived_parameter_holds_the_ratio_fixed(fmu_a, tmp_path):
 
 
 def test_an_integration_switched_by_omega_runs_each_point_with_its_own_integrator(fmu_a, tmp_path):
-    switched = Integration("event_driven", switch_omega=0.6, integrator_above="symplectic_euler")
+    switched = Integration("event_driven", switch=(("omega", 0.6),), integrator_above="symplectic_euler")
     base = base_point(fmu_a, horizon=200.0, transient=50.0)
     base = dataclasses.replace(base, run=dataclasses.replace(base.run, integration=switched))
     grid = Grid.parse(["omega=0.5,0.6,0.9"])
@@ -71,10 +71,11 @@ def test_an_integration_switched_by_omega_runs_each_point_with_its_own_integrato
         points[0].settings.run, integration=Integration("symplectic_euler")))).as_dict()
     assert other["phi"] != ds.phi.sel(omega=0.5).item()
     # Without omega a switched run cannot choose, and says so.
-    with pytest.raises(ValueError, match="needs the run's omega"):
+    with pytest.raises(ValueError, match="switched by omega needs the run's value"):
         RunSettings(integration=switched).fmu_values()
+    assert RunSettings(integration=switched).fmu_values({"omega": 0.9})["integrator"] == "symplectic_euler"
     with pytest.raises(ValueError, match="together"):
-        Integration("adaptive", switch_omega=1.0)
+        Integration("adaptive", switch=(("omega", 1.0),))
 
 
 def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a):

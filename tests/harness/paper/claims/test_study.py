@@ -36,8 +36,11 @@ def test_corrugated_models_run_adaptive_at_low_omega_and_the_paper_s_scheme_abov
         run = runner.run(model)
         assert run.integration == CORRUGATED_INTEGRATION
         assert {name: run.parameters[name] for name in CORRUGATED_TOLERANCES} == CORRUGATED_TOLERANCES
-        switch = CORRUGATED_INTEGRATION.switch_omega
-        assert run.with_parameters(omega=switch).fmu_values()["integrator"] == "adaptive"
-        assert run.with_parameters(omega=switch * 1.01).fmu_values()["integrator"] == "symplectic_euler"
+        limits = dict(CORRUGATED_INTEGRATION.switch)
+        assert set(limits) == {"omega", "V_d"}
+        at_limits = run.with_parameters(limits)
+        assert at_limits.fmu_values()["integrator"] == "adaptive"
+        for name, limit in limits.items():
+            assert at_limits.with_parameters({name: limit * 1.01}).fmu_values()["integrator"] == "symplectic_euler"
     # A study's own tolerance wins over the default one.
     assert runner.run("C", parameters={"rtol": 1e-9}).parameters["rtol"] == 1e-9
