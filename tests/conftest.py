@@ -13,6 +13,12 @@ sys.path.insert(0, str(ROOT / "build"))
 # they are imported by path (--import-mode=importlib) rather than put on sys.path.
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+# Tests run plain pythonfmu FMUs (built without the project's front end) through fmpy in
+# this process; their library would corrupt the heap at exit (harness/cosim/exit_guard.py).
+from harness.cosim import exit_guard  # noqa: E402
+
+exit_guard.install()
+
 
 @pytest.fixture(scope="session", autouse=True)
 def kernels_compiled_by_the_build():
