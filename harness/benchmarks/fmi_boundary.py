@@ -9,7 +9,9 @@ Prints side by side:
    (tests/build/fmi_host.c: process start to the end of the first doStep, Python start
    included) and in fmpy (a child process: instantiate to the end of the first doStep).
    ``--without-shipped-kernels`` adds the cold case with the FMU's compiled kernels
-   removed, i.e. numba compiling everything (about half a minute);
+   removed, i.e. numba compiling everything (about half a minute); and, in fmpy, the cold
+   first doStep of BlockC.fmu in a reading other than the default (tangent frame,
+   applied-load bound) with the ``adaptive`` integrator, whose kernels ship as well;
 2. at 1000 internal steps per doStep: time per doStep through the C master and fmpy
    against the bare core doing the same work, and time per output read after each step
    (5 outputs read in one call), with the FMU's native front end calling the slave's
@@ -23,6 +25,7 @@ Prints side by side:
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import shutil
 import subprocess
@@ -44,16 +47,18 @@ BLOCK = 100  # doSteps per block (the C master's BENCH_BLOCK)
 THROUGH_PYTHONFMU = "VIBROBLOCK_PYTHONFMU_DOSTEP"  # "1": the front end leaves doStep to pythonfmu
 
 FMPY_FIRST_STEP = textwrap.dedent("""
-    import sys, time
+    import json, sys, time
     from fmpy import read_model_description
     from fmpy.fmi2 import FMU2Slave
-    folder = sys.argv[1]
+    folder, model, integers = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
     md = read_model_description(folder)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
     start = time.perf_counter()
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier="BlockA", instanceName="first")
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=model, instanceName="first")
     slave.instantiate()
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
+    slave.setInteger([vr[name] for name in integers], list(integers.values()))
     slave.exitInitializationMode()
     slave.doStep(0.0, 0.4)
     print(time.perf_counter() - start)
@@ -91,9 +96,9 @@ def host_first_step(host, folder, md, cache) -> float:
     return float(done.stdout.split("first_step_s")[1].split()[0])
 
 
-def fmpy_first_step(folder, cache) -> float:
-    done = subprocess.run([sys.executable, "-c", FMPY_FIRST_STEP, str(folder)], capture_output=True, text=True,
-                          env=child_env(cache), check=True)
+def fmpy_first_step(folder, cache, model: str = "BlockA", integers: dict | None = None) -> float:
+    done = subprocess.run([sys.executable, "-c", FMPY_FIRST_STEP, str(folder), model, json.dumps(integers or {})],
+                          capture_output=True, text=True, env=child_env(cache), check=True)
     return float(done.stdout.split()[-1])
 
 
@@ -211,8 +216,8 @@ def main(argv=None):
     with tempfile.TemporaryDirectory(prefix="vibroblock-bench-") as tmp:
         work = Path(tmp)
         host = compile_host(work)
-        print(f"1. first doStep (1000 internal steps) of a freshly extracted BlockA.fmu, seconds")
-        print(f"   {'':34} {'C master':>9} {'fmpy':>9}")
+        print("1. first doStep (1000 internal steps) of a freshly extracted BlockA.fmu, seconds")
+        print(f"   {'':52} {'C master':>9} {'fmpy':>9}")
         rows = [("cold: empty numba cache", True, "cold"), ("warm: cache of the cold run", True, "cold")]
         if args.without_shipped_kernels:
             rows.append(("cold, shipped kernels removed", False, "bare"))
@@ -225,7 +230,14 @@ def main(argv=None):
                 folder = extract(fmu, work / f"x-{kind}-{n}", keep)
                 figures.append(host_first_step(host, folder, md, cache) if kind == "host"
                                else fmpy_first_step(folder, cache))
-            print(f"   {label:34} {figures[0]:9.2f} {figures[1]:9.2f}")
+            print(f"   {label:52} {figures[0]:9.2f} {figures[1]:9.2f}")
+        # A reading other than the default, with the stiff-stable integrator: its kernels
+        # ship too, so it does not compile either (fmpy only: the C master runs BlockA).
+        reading = {"formulation": 1, "coulomb_normal": 1, "integrator": 4}
+        folder = extract(args.fmu_dir / "BlockC.fmu", work / "x-fmpy-reading")
+        cache = work / "cache-fmpy-reading"
+        first_step = fmpy_first_step(folder, cache, "BlockC", reading)
+        print(f"   {'cold: BlockC, tangent frame, applied load, adaptive':52} {'-':>9} {first_step:9.2f}")
 
         folder = extract(fmu, work / "x-boundary")
         cache = work / "cache-host-cold"
