@@ -60,6 +60,17 @@ def _assignment(text: str) -> tuple[str, float | bool | str]:
         return name, value
 
 
+def _limit(text: str) -> tuple[str, float]:
+    """NAME=NUMBER: a parameter's limit for --switch."""
+    name, sep, value = text.partition("=")
+    try:
+        if not sep or not name.strip():
+            raise ValueError
+        return name.strip(), float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not NAME=NUMBER") from None
+
+
 def _resolve_choices(fmu: str, assignments: list) -> dict:
     """The --set values with choice names (formulation=tangent_frame) replaced by their
     codes, read from the FMU's description of that Integer parameter."""
@@ -99,6 +110,13 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
     group.add_argument("--integrator", default="symplectic_euler", choices=_choices("integrator"),
                        help="internal integrator, as the FMU names it (default symplectic_euler)")
     group.add_argument("--dt", type=float, default=4e-4, help="internal step (default 4e-4)")
+    group.add_argument("--switch", action="append", default=[], type=_limit, metavar="NAME=LIMIT",
+                       help="with --integrator-above (repeatable): a run in which parameter NAME exceeds LIMIT "
+                            "uses --integrator-above instead of --integrator, chosen per sweep point, e.g. "
+                            "--integrator adaptive --switch omega=2 --integrator-above symplectic_euler "
+                            "(README, 'Choosing speed or accuracy')")
+    group.add_argument("--integrator-above", default=None, choices=_choices("integrator"),
+                       help="the integrator of the runs beyond a --switch limit")
     group.add_argument("--initial-state", default="steady_orbit", choices=_choices("initial_state"),
                        help="the FMU's initial_state (default steady_orbit)")
     for name in ("x_start", "z_start", "vx_start", "vz_start"):
@@ -116,7 +134,7 @@ def _point(args) -> PointSettings:
     fmu = args.fmu or default_fmu(args.model)
     run = RunSettings.for_model(
         args.model, args.preset, fmu=fmu, parameters=Parameters(_resolve_choices(fmu, args.parameters)),
-        horizon=args.horizon, output_interval=args.interval, integration=Integration(args.integrator, args.dt),
+        horizon=args.horizon, output_interval=args.interval, integration=Integration(args.integrator, args.dt, tuple(args.switch), args.integrator_above),
         initial=InitialCondition(args.initial_state, args.x_start, args.z_start, args.vx_start, args.vz_start))
     transient = args.horizon / 5 if args.transient is None else args.transient
     observe = ObservableSettings(transient=transient, window=args.window, phi_threshold=args.phi_threshold)

@@ -43,6 +43,23 @@ def test_sweep_from_a_toml_grid_file_with_a_derived_parameter(fmu_a, tmp_path, c
     assert ds.phi.dims == ("k_n", "ratio") and float(ds.gamma_n.sel(k_n=2.0, ratio=20.0)) == 0.1
 
 
+def test_sweep_with_an_integrator_switched_by_omega(fmu_a, tmp_path, capsys):
+    out = tmp_path / "sweep.zarr"
+    code = cli.main(["sweep", "--fmu", str(fmu_a), "--grid", "omega=0.5,0.9", "--horizon", "100",
+                     "--integrator", "event_driven", "--switch", "omega=0.6", "--integrator-above", "symplectic_euler",
+                     "--scheduler", "inline", "--store", str(tmp_path / "store"), "--out", str(out), "--no-progress"])
+    assert code == 0, capsys.readouterr().err
+    ds = load_dataset(out)
+    assert ds.attrs["integrator_name"] == "event_driven at omega <= 0.6, symplectic_euler otherwise"
+    stored = sorted(json.loads(path.read_text())["inputs"]["fmu_values"]["integrator"]
+                    for path in (tmp_path / "store").rglob("*.json") if "inputs" in json.loads(path.read_text()))
+    assert stored == ["event_driven", "symplectic_euler"]
+    # A limit without the integrator beyond it is refused in one line.
+    assert cli.main(["sweep", "--fmu", str(fmu_a), "--grid", "omega=0.5", "--horizon", "100", "--switch", "omega=0.6",
+                     "--scheduler", "inline", "--no-progress"]) == 2
+    assert "together" in capsys.readouterr().err
+
+
 def test_continuation_command(fmu_a, tmp_path, capsys):
     out = tmp_path / "loop.nc"
     code = cli.main(["continuation", "--fmu", str(fmu_a), "--parameter", "omega", "--values", "0.4,0.6",
