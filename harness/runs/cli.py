@@ -134,7 +134,8 @@ def _point(args) -> PointSettings:
     fmu = args.fmu or default_fmu(args.model)
     run = RunSettings.for_model(
         args.model, args.preset, fmu=fmu, parameters=Parameters(_resolve_choices(fmu, args.parameters)),
-        horizon=args.horizon, output_interval=args.interval, integration=Integration(args.integrator, args.dt, tuple(args.switch), args.integrator_above),
+        horizon=args.horizon, output_interval=args.interval,
+        integration=Integration(args.integrator, args.dt, tuple(args.switch), args.integrator_above),
         initial=InitialCondition(args.initial_state, args.x_start, args.z_start, args.vx_start, args.vz_start))
     transient = args.horizon / 5 if args.transient is None else args.transient
     observe = ObservableSettings(transient=transient, window=args.window, phi_threshold=args.phi_threshold)

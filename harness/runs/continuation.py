@@ -161,7 +161,8 @@ def _attributes(point: PointSettings, ramp: Ramp, values: dict, sha256: str, mod
         "kind": kind, "ramp_parameter": ramp.parameter, "ramp": json.dumps(to_jsonable(ramp)),
         "step_duration": point.run.horizon, "output_interval": point.run.output_interval,
         "fmu_path": point.run.fmu, "fmu_sha256": sha256, "model_name": model_name,
-        "integrator_name": point.run.with_parameters({ramp.parameter: values[ramp.parameter]}).integrator_for(values),
+        # values: the parameters as the ramp started (its first value included).
+        "integrator_name": point.run.integration.for_values(values),
         "initial_condition": point.run.initial.initial_state,
         "transient": observe_settings.transient,
         "window": "rest of step" if observe_settings.window is None else observe_settings.window,

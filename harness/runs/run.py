@@ -106,7 +106,7 @@ def run_attributes(instance: FmuInstance, settings: RunSettings, values: dict) -
     """Attributes describing a run completely (NetCDF-safe scalars and strings)."""
     # NetCDF has no boolean attributes: flags are stored as 0/1.
     # Switches given by name are stored as the FMU's values (their names as *_name).
-    integrator = settings.integrator_for(values)
+    integrator = settings.integration.for_values(values)  # values: every parameter as used
     values = {name: instance.interface.encode(name, value) for name, value in values.items()}
     attrs = {name: int(value) if isinstance(value, bool) else value for name, value in values.items()}
     attrs.update({

@@ -218,10 +218,6 @@ class RunSettings:
         (a value it does not set is the FMU's default, from ``defaults``)."""
         return self.integration.for_values({**dict(defaults or {}), **dict(self.parameters)})
 
-    @property
-    def integrator(self) -> str:
-        return self.integrator_for()
-
     def fmu_values(self, defaults: Mapping | None = None) -> dict[str, float | int]:
         """Values to set on the FMU besides its ``defaults``: parameters, integration, start."""
         return {**dict(self.parameters), "dt": self.integration.dt,

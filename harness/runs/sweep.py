@@ -242,10 +242,10 @@ def grid_points(grid: Grid, base: PointSettings, interface: FmuInterface, sha256
 
 def point_inputs(point: PointSettings, sha256: str, interface: FmuInterface) -> dict:
     """Everything a point's result depends on (its store key is the hash of this)."""
-    run = point.run
+    run, defaults = point.run, interface.defaults()
     return {
         "fmu_sha256": sha256, "model_name": interface.model_name,
-        "fmu_values": {**interface.defaults(), **run.fmu_values(interface.defaults())},
+        "fmu_values": {**defaults, **run.fmu_values(defaults)},
         "integration": to_jsonable(run.integration), "initial": to_jsonable(run.initial),
         "horizon": run.horizon, "output_interval": run.output_interval, "start_time": run.start_time,
         "observe": to_jsonable(point.observe), "observables_version": OBSERVABLES_VERSION,
