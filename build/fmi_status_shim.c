@@ -589,9 +589,11 @@ static void report_from_slave(void* context, int status, const char* category, c
     shim_logger(inst, inst->name, (fmi2Status)status, category, message);
 }
 
-/* The slave's do_step called directly (python_runtime.c says why), with what pythonfmu
- * would do around it: True is fmi2OK, False fmi2Discard (raised to fmi2Error by the
- * error the slave logged), and the end of the last step taken kept for
+/* A plain doStep runs natively, through the Block's NativeStep record (no Python, no
+ * GIL: python_slave_native_step); any other goes to the slave's do_step, called directly
+ * (python_runtime.c says why).  Both with what pythonfmu would do around it: True is
+ * fmi2OK, False fmi2Discard (raised to fmi2Error by the error the slave logged), and the
+ * end of the last step taken kept for
  * fmi2GetRealStatus(fmi2LastSuccessfulTime) (a refused step leaves it, where pythonfmu
  * would record the refused step's start).  Without a claimed slave
  * (VIBROBLOCK_PYTHONFMU_DOSTEP=1, a slave that is no vibroblock facade, a Python without
@@ -610,7 +612,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
         inst->stepped = 0;  /* pythonfmu's record is the current one again */
         return worse(returned, inst->logged);
     }
-    int taken = python_slave_do_step(&inst->slave, currentCommunicationPoint, communicationStepSize,
+    int taken = python_slave_native_step(&inst->slave, currentCommunicationPoint, communicationStepSize) ||
+                python_slave_do_step(&inst->slave, currentCommunicationPoint, communicationStepSize,
                                      report_from_slave, inst);
     if (taken) {
         inst->stepped = 1;

@@ -46,6 +46,7 @@ WARM_UP = r"""
 import itertools, sys
 import vibroblock
 from vibroblock import Block, INTEGRATORS, ModelError
+from vibroblock.native import NativeStep
 from vibroblock.models import VARIANTS, offered_by
 from vibroblock.parameters import READINGS, SCENE_OPTIONS
 
@@ -82,6 +83,7 @@ for model, integrator, configs in mine:
     for options, energy, initial in configs:
         try:
             block = Block(model, integrator, initial, energy, A=0.3, omega=0.5, **options)
+            block.drive_natively(NativeStep(), 1e-9)  # as the FMU's slave: its C entry too
             block.start(0.0)
             block.advance_to(1.0)
             block.set_plate_input(0.01, 0.0, 0.0)

@@ -40,7 +40,9 @@
 #include <dlfcn.h>
 #include <glob.h>
 #include <limits.h>
+#include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -92,6 +94,7 @@ static struct {
     PyObj (*PyList_GetItem)(PyObj, long);
     PyObj (*PyTuple_GetItem)(PyObj, long);
     long (*PyLong_AsLong)(PyObj);
+    void* (*PyLong_AsVoidPtr)(PyObj);
     void (*PyErr_Clear)(void);
     int bound;
 } slave_api;
@@ -109,6 +112,7 @@ static int bind_api(void* handle)
     BIND_SLAVE(PyFloat_FromDouble) BIND_SLAVE(PyObject_CallFunctionObjArgs) BIND_SLAVE(PyObject_Vectorcall)
     BIND_SLAVE(PyObject_GetAttrString) BIND_SLAVE(PyObject_IsTrue) BIND_SLAVE(PyList_Size)
     BIND_SLAVE(PyList_GetItem) BIND_SLAVE(PyTuple_GetItem) BIND_SLAVE(PyLong_AsLong) BIND_SLAVE(PyErr_Clear)
+    BIND_SLAVE(PyLong_AsVoidPtr)
 #undef BIND_SLAVE
     slave_api.bound = slave_api.PyFloat_FromDouble && slave_api.PyObject_CallFunctionObjArgs &&
                       slave_api.PyObject_GetAttrString && slave_api.PyObject_IsTrue && slave_api.PyList_Size &&
@@ -471,6 +475,68 @@ int python_runtime_ready(const char* fmu_root, char* error, size_t size)
  * ones given to pythonfmu.  A slave that is not a vibroblock facade (no such module or
  * no such slave) keeps pythonfmu's doStep. */
 
+/* ---- a doStep without Python ------------------------------------------------------ */
+
+/* The record a Block keeps for a front end (vibroblock/native.py, NativeStep: the same
+ * fields in the same order; LAYOUT there is NATIVE_LAYOUT here). */
+#define NATIVE_LAYOUT 1
+typedef struct {
+    int64_t layout;
+    int64_t ready;    /* a run has started and its advance kernel is bound */
+    int64_t held;     /* an input waits to be applied by the slave */
+    int64_t (*advance)(int64_t flags, double* y, int64_t* cnt, double* drv, double* prm, int64_t n_steps,
+                       int64_t track_energy);
+    int64_t returned_ok;
+    int64_t flags;
+    double* y;
+    int64_t* cnt;
+    double* drv;
+    double* prm;
+    int64_t step_slot;
+    int64_t track_energy;
+    double step_budget;
+    double t0, dt;
+    double time;
+    double grid_tolerance, time_tolerance;
+} NativeStep;
+
+/* The slave's record (its attribute native_step, the address), or NULL. */
+static void* claim_native_step(PyObj slave)
+{
+    if (slave_api.PyLong_AsVoidPtr == NULL) return NULL;
+    PyObj address = slave_api.PyObject_GetAttrString(slave, "native_step");
+    NativeStep* record = address != NULL ? (NativeStep*)slave_api.PyLong_AsVoidPtr(address) : NULL;
+    if (address != NULL) py.Py_DecRef(address);
+    slave_api.PyErr_Clear();
+    return record != NULL && record->layout == NATIVE_LAYOUT ? record : NULL;
+}
+
+/* Block.advance_to(t + h) for the request the slave's do_step takes straight to it (a
+ * started run with no input waiting, at the block's own time up to the slave's
+ * tolerance, 0 < h < inf), with the same arithmetic, so the same grid steps and bits.
+ * Anything else, and a kernel call that does not simply finish (a failure, which leaves
+ * the state as it was; a scene's guard stopping early, which keeps the steps taken; a
+ * kernel that raised), is left to the slave's do_step, which starts from the state the
+ * call left and says what is wrong.  No Python runs here, so no GIL is taken. */
+int python_slave_native_step(const PythonSlave* slave, double t, double h)
+{
+    NativeStep* n = (NativeStep*)slave->native;
+    if (n == NULL || !n->ready || n->held || !(0.0 < h && h < INFINITY)) return 0;
+    double now = n->time;
+    if (!(t == now || fabs(t - now) <= n->time_tolerance * fmax(1.0, fabs(now)))) return 0;
+    double end = now + h;
+    if (!(now < end && end < INFINITY)) return 0;
+    double target = floor((end - n->t0) / n->dt + n->grid_tolerance);
+    double step = (double)n->cnt[n->step_slot];
+    if (!(target - step <= n->step_budget) || target >= 9.2e18) return 0;
+    if (target > step &&
+        n->advance(n->flags, n->y, n->cnt, n->drv, n->prm, (int64_t)target - (int64_t)step, n->track_energy)
+            != n->returned_ok)
+        return 0;
+    n->time = end;
+    return 1;
+}
+
 int python_slave_claim(PythonSlave* slave, const char* instance_name, const char* resource_location)
 {
     memset(slave, 0, sizeof *slave);
@@ -491,6 +557,7 @@ int python_slave_claim(PythonSlave* slave, const char* instance_name, const char
         if (slave->log_queue != NULL) {
             slave->slave = made;
             made = NULL;
+            slave->native = claim_native_step(slave->slave);
         } else if (slave->do_step != NULL) {
             py.Py_DecRef(slave->do_step);
             slave->do_step = NULL;

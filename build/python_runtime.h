@@ -16,6 +16,7 @@ typedef struct {
     void* slave;      /* the slave object */
     void* do_step;    /* its bound do_step */
     void* log_queue;  /* the list pythonfmu reads its messages from */
+    void* native;     /* its Block's record for a doStep without Python, or NULL */
 } PythonSlave;
 
 /* A log message of a direct call: status (fmi2Status), category, text. */
@@ -32,5 +33,9 @@ void python_slave_release(PythonSlave* slave);
 /* slave.do_step(t, h): 1 when it returned True, else 0.  Messages the slave logged, and
  * an exception escaping it, are passed to `report` before this returns. */
 int python_slave_do_step(const PythonSlave* slave, double t, double h, PythonSlaveReport report, void* context);
+
+/* Advance the slave's block natively from t by h: 1 when done, 0 when the request must go
+ * to python_slave_do_step (it then starts from the state this call left). */
+int python_slave_native_step(const PythonSlave* slave, double t, double h);
 
 #endif

@@ -56,7 +56,7 @@ WORK_DIR = HERE / "work"
 PLATFORM = "linux64"
 INNER_SUFFIX = "_pythonfmu.so"  # must match INNER_SUFFIX in fmi_status_shim.c
 CFLAGS = ("-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-Wall", "-Wextra")
-LIBS = ("-ldl", "-lpthread")
+LIBS = ("-ldl", "-lpthread", "-lm")
 
 PathLike = Union[str, os.PathLike]
 

@@ -14,6 +14,7 @@ import numpy as np
 from . import interface
 from . import layout as L
 from .initial_state import frame_to_point, place
+from .native import LAYOUT, RETURNED_OK, NativeStep, entry_address
 from .settings import ModelError, Settings
 
 OUTPUTS = tuple(interface.OUTPUTS)
@@ -45,6 +46,12 @@ class Block:
         self.started = False
         self.frozen_released = False  # the frozen_vertical guard has handed over to the full model
         self._observed = None
+        self._observed_time = math.nan
+        # The run's time, and what a native front end needs to advance it (vibroblock.native).
+        self._native = NativeStep(layout=LAYOUT, returned_ok=RETURNED_OK, step_slot=L.C_STEP,
+                                  grid_tolerance=GRID_TOLERANCE, time=math.nan)
+        self._native_entry = None  # C address of the bound advance kernel, if a front end asked for one
+        self._natively_driven = False
 
     # ------------------------------------------------------------------ settings
     model = property(lambda self: self.settings.model)
@@ -74,6 +81,39 @@ class Block:
 
     def set_scene_option(self, name: str, enabled: bool) -> None:
         self.settings.set_scene_option(name, enabled)
+
+    # ------------------------------------------------------------------ native front end
+    time = property(lambda self: self._native.time, lambda self, t: setattr(self._native, "time", t),
+                    doc="The run's time (kept in the NativeStep record, which a native front end advances).")
+
+    def drive_natively(self, record: NativeStep, time_tolerance: float) -> None:
+        """Let a native front end advance this block through ``record`` (its time moves
+        there), with ``time_tolerance`` the front end's match of a master's time to the
+        block's.  The record takes over this block's time and arrays; a record already
+        driving another block is simply re-pointed at this one."""
+        record.time, record.time_tolerance = self.time, time_tolerance
+        for name in ("layout", "returned_ok", "step_slot", "grid_tolerance"):
+            setattr(record, name, getattr(self._native, name))
+        self._native, self._natively_driven = record, True
+        record.ready = 0
+        if self.started:
+            self._bind_kernels()
+
+    def _publish_native(self) -> None:
+        """Point the record at the bound kernel and arrays; ready once the run has started."""
+        record = self._native
+        record.ready = 0
+        if not self._natively_driven:
+            return
+        settings, kernel = self.settings, self._kernel
+        self._native_entry = entry_address(kernel.advance, settings.kind, kernel.id)
+        record.advance = self._native_entry
+        record.flags = settings.scene_flags(self.frozen_released)
+        record.y, record.cnt, record.drv, record.prm = (a.ctypes.data for a in (self.y, self.cnt, self.drv, self.prm))
+        record.track_energy = int(self._track_energy)
+        record.step_budget = self._step_budget
+        record.t0, record.dt = self._grid
+        record.ready = int(self.started and self._native_entry is not None)
 
     def check_stability(self) -> None:
         self.settings.check(self.frozen_released)
@@ -106,11 +146,13 @@ class Block:
         self.cnt = np.zeros(L.N_CNT, dtype=np.int64)
         self.y = np.zeros(L.N_Y)
         self.obs = np.zeros(L.N_OBS)
+        self._native.ready = 0
         self.time = t0
         self._bind_kernels()
         if not place(self.settings, self.prm, self.drv, self.y):
             self._release_frozen_vertical()
         self.started = True
+        self._publish_native()
         self.settings.locked = True
         # The normal spring's energy starts at k_n delta^2 / 2 and then integrates its power.
         self._observed = None
@@ -153,6 +195,7 @@ class Block:
         self._grid = (float(self.drv[L.D_T0]), float(self.drv[L.D_DT]))
         self._grid_step = partial(self.cnt.item, L.C_STEP)  # the grid index, read without a lookup
         self._step_budget = STEP_BUDGET_PER_CALL if kernel.force_evaluations > 0 else math.inf
+        self._publish_native()
 
     def advance_to(self, t_end: float) -> None:
         """Advance to t_end > current time; on failure the state is left unchanged."""
@@ -239,7 +282,9 @@ class Block:
                 + 0.5 * p["k_t"] * shear * shear + e_normal)
 
     def _observables(self) -> dict:
-        if self._observed is None:
+        # A native front end advances the time without dropping the cache: the cache is the
+        # observation at one time.
+        if self._observed is None or self._observed_time != self.time:
             self._require_started()
             obs = self._observe()
             residual = 0.0
@@ -263,6 +308,7 @@ class Block:
                 "energy_dissipated": float(obs[L.O_DISSIPATED]),
                 "energy_residual": float(residual),
             }
+            self._observed_time = self.time
         return self._observed
 
     def _as_point(self, x, z, vx, vz, pen):
@@ -304,10 +350,11 @@ class Block:
             raise ModelError("not a valid block state: array sizes differ from this model's")
         settings.locked = True
         self.settings = settings
+        self._native.ready = 0
         self.y, self.cnt, self.drv, self.prm = y, cnt, drv, prm
         self.obs = np.zeros(L.N_OBS)
         self.frozen_released = bool(state.get("frozen_released", False))
         self.time = float(state["time"])
-        self._bind_kernels()
         self.started = True
+        self._bind_kernels()
         self._observed = None

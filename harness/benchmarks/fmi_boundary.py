@@ -14,10 +14,12 @@ Prints side by side:
    applied-load bound) with the ``adaptive`` integrator, whose kernels ship as well;
 2. at 1000 internal steps per doStep: time per doStep through the C master and fmpy
    against the bare core doing the same work, and time per output read after each step
-   (5 outputs read in one call), with the FMU's native front end calling the slave's
-   do_step directly (as shipped) and, for comparison, with every doStep through
-   pythonfmu's library (``VIBROBLOCK_PYTHONFMU_DOSTEP=1``), and fmpy's own cost of an
-   FMI call (timed on one that does not enter Python).  Each figure is given as the mean over all doSteps and
+   (5 outputs read in one call), with the FMU's native front end running each doStep
+   without Python (as shipped: the compiled kernel called through the Block's
+   NativeStep record, vibroblock/native.py) and, for comparison, with every doStep a
+   Python call through pythonfmu's library (``VIBROBLOCK_PYTHONFMU_DOSTEP=1``), and
+   fmpy's own cost of an FMI call (timed on one that does not enter Python).  Each
+   figure is given as the mean over all doSteps and
    as the mean of the quietest block of BLOCK doSteps: on a shared machine the load of
    other processes comes and goes, and the quietest blocks of the FMU and of the core
    compare the work itself.

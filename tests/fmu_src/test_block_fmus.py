@@ -35,7 +35,9 @@ def instance(extracted, model, log, start_values=None, name="block"):
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
         for key, value in (start_values or {}).items():
-            if isinstance(value, int):
+            if isinstance(value, bool):
+                slave.setBoolean([vr[key]], [value])
+            elif isinstance(value, int):
                 slave.setInteger([vr[key]], [value])
             else:
                 slave.setReal([vr[key]], [value])
@@ -239,6 +241,70 @@ def test_do_steps_through_pythonfmu_give_the_same_bits(extracted, fmu_log, monke
             runs.append(np.array(rows))
     assert runs[0].tobytes() == runs[1].tobytes()
     assert np.ptp(runs[0][:, 1]) > 1e-3  # z moves: the run exercises the block
+
+
+NATIVE_CASES = [
+    ("A", {"A": 0.8, "omega": 0.7, "initial_state": 2}),
+    ("A", {"A": 0.02, "omega": 0.5, "frozen_vertical": True}),  # A = 6 at step 40: the guard hands over
+    ("B", {**SCALED, "A": 0.2, "omega": 0.7, "integrator": 4, "formulation": 1}),
+    ("C", {**SCALED, "A": 0.3, "omega": 0.85, "integrator": 3}),
+]
+
+
+def scripted_run(extracted, log, model, settings):
+    """60 doSteps of 0.5 with a plate input set before every tenth, a refused doStep, and
+    an FMU state restored: (outputs after each step, time of each doStep Python ran)."""
+    from vibroblock import slave as slave_module
+
+    python_steps = []
+    original = slave_module.BlockFacade.do_step
+
+    def counted(self, t, h):
+        python_steps.append(t)
+        return original(self, t, h)
+
+    rows = []
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(slave_module.BlockFacade, "do_step", counted)
+        with instance(extracted, model, log, settings) as (slave, vr):
+            t = 0.0
+            for k in range(60):
+                if k % 10 == 5:
+                    assert set_real(slave, vr["plate_z"], 1e-3 * k) == fmi2OK
+                if k == 40 and settings.get("frozen_vertical"):
+                    assert set_real(slave, vr["A"], 6.0) == fmi2OK  # A omega^2 = 1.5 g
+                if k == 30:
+                    saved, saved_at = slave.getFMUstate(), t
+                    assert do_step(slave, t + 3.0, 0.5) == fmi2Error  # not the FMU's time
+                assert do_step(slave, t, 0.5) == fmi2OK
+                t += 0.5
+                rows.append(reals(slave, vr))
+            slave.setFMUstate(saved)
+            for t in saved_at + 0.5 * np.arange(10):
+                assert do_step(slave, t, 0.5) == fmi2OK
+                rows.append(reals(slave, vr))
+            slave.freeFMUstate(saved)
+    return np.array(rows), python_steps
+
+
+@pytest.mark.parametrize("model, settings", NATIVE_CASES)
+def test_plain_do_steps_run_without_python_and_give_the_same_bits(extracted, fmu_log, monkeypatch, model,
+                                                                    settings):
+    """The front end runs a plain doStep through the Block's NativeStep record
+    (vibroblock/native.py), with no Python call; a doStep after a new input, a refused
+    one and the one where frozen_vertical's guard hands over go to the slave's do_step.
+    Left to pythonfmu (every doStep a Python call) the run has the same bits."""
+    native, python_steps = scripted_run(extracted, fmu_log, model, settings)
+    monkeypatch.setenv("VIBROBLOCK_PYTHONFMU_DOSTEP", "1")
+    through_python, every_step = scripted_run(extracted, fmu_log, model, settings)
+    assert native.tobytes() == through_python.tobytes()
+    assert len(every_step) == 71
+    inputs = [0.5 * k for k in range(5, 60, 10)]
+    refused = 18.0
+    handover = set(python_steps) - {*inputs, refused}
+    assert [t for t in python_steps if t not in handover] == [*inputs[:3], refused, *inputs[3:]]
+    assert len(handover) == (1 if settings.get("frozen_vertical") else 0)
+    assert np.ptp(native[:, 1]) > 1e-4  # z moves: the run exercises the block
 
 
 def test_fixed_parameters_cannot_change_during_a_run(extracted, fmu_log):

@@ -1,0 +1,116 @@
+"""A doStep that does not enter Python: the advance kernels as C functions.
+
+Through pythonfmu every doStep is a Python call (GIL, frames, the numba entry point
+unboxing four arrays): about 1.3 us, a tenth of a doStep of a thousand internal steps
+of model A (``harness/benchmarks/fmi_boundary.py``).  The FMU's native front end
+(``build/python_runtime.c``) can do without it.  A ``Block`` that a front end drives
+keeps a ``NativeStep`` record up to date: the C address of its integrator's advance
+kernel compiled as a numba ``cfunc`` for the run's model and reading, its state arrays,
+its time grid and the checks a doStep makes.  The front end reads the record, makes
+the same checks as ``Block.advance_to`` and calls the kernel with the same arguments,
+so the state advances bit for bit as through Python.  Everything else -- set-up, inputs,
+outputs, FMU state, logging, and any doStep that does not simply succeed -- stays with
+the Python slave: the front end then calls the slave's do_step, which finds the state
+as the failed kernel call left it (contract rule 4 of ``vibroblock.integrators``) and
+says what went wrong.
+
+The record is laid out as ``NativeStep`` in ``build/python_runtime.c``; ``LAYOUT``
+names the version both sides check.
+"""
+from __future__ import annotations
+
+import ctypes
+
+from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
+from numba import carray, cfunc, types  # noqa: E402
+
+from . import layout as L  # noqa: E402
+from .integrators import adaptive, event_driven, fixed_step  # noqa: E402
+
+LAYOUT = 1  # bump with any change of NativeStep's fields
+
+# A cfunc whose kernel raised returns 0 (numba zero-fills the result, prints the
+# exception and carries on), so the kernel's status is returned shifted: 0 is never a
+# status the kernel gave.
+STATUS_SHIFT = 1 << 20
+RETURNED_OK = STATUS_SHIFT + fixed_step.OK
+
+_F64, _I64 = types.CPointer(types.float64), types.CPointer(types.int64)
+# (flags, y, cnt, drv, prm, n_steps, track_energy) -> status + STATUS_SHIFT
+SIGNATURE = types.int64(types.int64, _F64, _I64, _F64, _F64, types.int64, types.int64)
+
+
+class NativeStep(ctypes.Structure):
+    """What a front end needs to run a doStep without Python.  ``ready`` is set by the
+    Block once a run has started and its kernels are bound; ``held`` by the FMU slave
+    while an input waits to be applied (both 0: the next doStep may go native)."""
+    _fields_ = [
+        ("layout", ctypes.c_int64),
+        ("ready", ctypes.c_int64),
+        ("held", ctypes.c_int64),
+        ("advance", ctypes.c_void_p),  # SIGNATURE
+        ("returned_ok", ctypes.c_int64),  # what advance returns when the kernel finished
+        ("flags", ctypes.c_int64),
+        ("y", ctypes.c_void_p),
+        ("cnt", ctypes.c_void_p),
+        ("drv", ctypes.c_void_p),
+        ("prm", ctypes.c_void_p),
+        ("step_slot", ctypes.c_int64),  # cnt[step_slot] is the grid index
+        ("track_energy", ctypes.c_int64),
+        ("step_budget", ctypes.c_double),  # grid steps one call may take
+        ("t0", ctypes.c_double),
+        ("dt", ctypes.c_double),
+        ("time", ctypes.c_double),  # the Block's time: read and written by both sides
+        ("grid_tolerance", ctypes.c_double),  # Block.advance_to's rounding to the grid
+        ("time_tolerance", ctypes.c_double),  # the slave's match of a master's time to its own
+    ]
+
+
+# One factory per advance kernel, each compiling a cfunc for one (kind, method): the
+# kernels take both as literals.  The kernel is named in the body, not captured: numba
+# keys a cached cfunc by its closure's values, which must be plain numbers to be found
+# again by the next process.
+def _fixed_step_entry(kind: int, method: int):
+    @cfunc(SIGNATURE, cache=True)
+    def advance(flags, y, cnt, drv, prm, n_steps, track_energy):
+        return STATUS_SHIFT + fixed_step.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
+                                                 carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
+                                                 track_energy != 0)
+    return advance
+
+
+def _event_driven_entry(kind: int, method: int):
+    @cfunc(SIGNATURE, cache=True)
+    def advance(flags, y, cnt, drv, prm, n_steps, track_energy):
+        return STATUS_SHIFT + event_driven.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
+                                                   carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
+                                                   track_energy != 0)
+    return advance
+
+
+def _adaptive_entry(kind: int, method: int):
+    @cfunc(SIGNATURE, cache=True)
+    def advance(flags, y, cnt, drv, prm, n_steps, track_energy):
+        return STATUS_SHIFT + adaptive.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
+                                               carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
+                                               track_energy != 0)
+    return advance
+
+
+_FACTORIES = {fixed_step.advance: _fixed_step_entry, event_driven.advance: _event_driven_entry,
+              adaptive.advance: _adaptive_entry}
+_ENTRIES: dict = {}  # (kernel, kind, method) -> cfunc, kept alive with its code
+
+
+def entry_address(kernel, kind: int, method: int) -> int | None:
+    """The C address of ``kernel`` for (kind, method), compiled or loaded from the cache
+    once per process; None for a kernel without a C entry."""
+    key = (kernel, kind, method)
+    if key not in _ENTRIES:
+        factory = _FACTORIES.get(kernel)
+        try:
+            _ENTRIES[key] = factory(kind, method) if factory is not None else None
+        except Exception:  # noqa: BLE001 - no C entry is no error: every doStep goes through Python
+            _ENTRIES[key] = None
+    entry = _ENTRIES[key]
+    return entry.address if entry is not None else None
