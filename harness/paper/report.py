@@ -119,8 +119,10 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
         lines += [f"- {k}: {v}" for k, v in header.items()] + [""]
     lines += ["Verdicts are computed from the measured numbers by the criteria stated in each claim's module (`harness/paper/claims/`) "
               f"(relative tolerance {FORMULA_TOLERANCE:.0%} for formulas, {UNCHANGED_TOLERANCE:.0%} for 'unchanged', "
-              "bracket tests on the sweep grids). 'Friction' means regime stick_slip or stuck (held in the window); "
-              "'sliding' means following the drive (phi below the threshold, drift >= V_d/2).", "",
+              "bracket tests on the sweep grids). 'Friction' means regime stick_slip, stuck or jammed (held in the "
+              "window); 'sliding' means following the drive without rests (drift >= V_d/2); 'hopping' large phi "
+              "without rests and with contact less than half the window; 'flying' no contact. The rules are in "
+              "`harness/runs/observables.py`.", "",
               "| claim | statement | measured | verdict | why | figures |", "|---|---|---|---|---|---|"]
     summary = {}
     for row in rows:
@@ -132,6 +134,11 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
     if reading_rows(studies):
         lines += ["", "Readings (see \"The readings side by side\"):"] + [f"- {line}" for line in reading_summary(studies)]
     lines += [""] + readings_markdown(studies)
+    described = [(name, CLAIMS[name].describe(study.measured)) for name, study in studies.items()
+                 if name in CLAIMS and CLAIMS[name].describe is not None]
+    if described:
+        lines += ["## Studies without a verdict of their own", ""] + [f"- {name}: {text}" for name, text in described]
+        lines += [""]
     lines += ["## Parameter sets and classification per study", "",
               "| study | settings |", "|---|---|"]
     for name, study in studies.items():

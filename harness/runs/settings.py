@@ -243,8 +243,11 @@ class ObservableSettings:
 
     * The measuring window is [t_end - window, t_end] (``window`` None: everything after
       the transient); its start is never earlier than start + ``transient``.
-    * Regime: stick-slip when phi > ``phi_threshold``, else sliding (or "stuck" when the
-      block neither slipped nor kept up with the drive: the window is too short).  A block
+    * Regime: stick-slip when phi > ``phi_threshold`` and the block rests (sticks) part of
+      the window, hopping when phi is large but the block neither rests nor stays in
+      contact, else sliding (or "stuck" when the block neither slipped nor kept up with
+      the drive: the window is too short); the full rules are in
+      :mod:`harness.runs.observables`.  A block
       that sticks throughout has phi = 1; one moving with the drive phi = 0; a stick-slip
       cycle adds its slips' share of (vx - V_d)^2 (about 170 for model A's scaled set).
     * Slips (see :func:`harness.runs.observables.slip_events`): a slip is a run of samples with

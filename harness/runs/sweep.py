@@ -66,7 +66,7 @@ from .store import PointStore, point_key
 
 # Bumped whenever the definition of an observable changes, so stored points of the old
 # definition get other keys.
-OBSERVABLES_VERSION = 2  # 2: regimes jammed and flying, slope angles at the stick sites
+OBSERVABLES_VERSION = 3  # 2: regimes jammed and flying, slope angles at the stick sites; 3: hopping, rest fraction
 POOL_PLUGIN = "vibroblock-fmu-pool"
 INLINE = "inline"
 

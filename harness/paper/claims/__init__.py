@@ -16,13 +16,13 @@ import time
 from typing import Sequence
 
 from . import (c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery,
-               c6r_recovery_question, c7_contact, c8_drive_velocity, fig1b)
+               c6r_recovery_question, c7_contact, c8_drive_velocity, fig1b, fig1c_paper)
 from .readings import DEFAULT_READING, READINGS, Reading, split_study_name, study_name
 from .measure import friction_held, onset_amplitude, recovery, stable_roots_near, transition_bracket
 from .study import RESOLUTIONS, Claim, Resolution, Runner, Study, counts, load_studies, save_studies, timing
 
 CLAIMS: dict[str, Claim] = {module.CLAIM.name: module.CLAIM for module in (
-    fig1b, c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery, c6r_recovery_question,
+    fig1b, c1_rest, c2_below_g, c3_onset, fig1c_paper, c4_hysteresis, c5_corrugated_plate, c6_recovery, c6r_recovery_question,
     c7_contact, c8_drive_velocity)}
 STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 

@@ -29,8 +29,8 @@ TEXT = {
     "C3b": "A: refined onset A_c(omega) = (g/omega^2)|k_n - m omega^2 + i gamma_n omega|/k_n",
 }
 FIGURES = {
-    "C3a": ["fig1c_phase_diagram_A.png"],
-    "C3b": ["fig1c_phase_diagram_A.png"],
+    "C3a": ["fig1c_phase_diagram_A.png", "fig1c_paper_parameters.png"],
+    "C3b": ["fig1c_phase_diagram_A.png", "fig1c_paper_parameters.png"],
 }
 
 

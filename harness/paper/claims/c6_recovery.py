@@ -122,7 +122,7 @@ def study_c6(runner: Runner) -> Study:
     }
     settings = {"model": "C", "parameters": C_PARAMETERS, "horizon": res.c_horizon, "initial": C_START,
                 "ramp_step": res.c6_ramp_step, **observe_json(observe_c),
-                "friction": "regime stick_slip or stuck (not sliding)"}
+                "friction": "regime stick_slip, stuck or jammed (not sliding, hopping or flying)"}
     data = {"omega": diagram.omega.values.tolist(), "A": diagram.A.values.tolist(),
             "regime": diagram.regime.transpose("A", "omega").values.tolist(),
             "recovery_vs_k": recovery_vs_k, "loop": loop}

@@ -10,7 +10,8 @@ Conventions used by all studies
   spring is relaxed (start_time = x_start / V_d), so that no spring force acts at t0.
 * "Friction" = the block is held by friction in the window: regime stick_slip, stuck
   (no slip and no sliding within the window) or jammed (self-locked on a flank);
-  "sliding" = it follows the drive; "flying" = no contact in the window (not friction).
+  "sliding" = it follows the drive; "hopping" = it neither rests nor stays in contact;
+  "flying" = no contact in the window (none of the three is friction).
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from typing import Sequence
 import numpy as np
 
 from harness.runs.continuation import continuation
-from harness.runs.observables import FLYING, SLIDING, observe, window, window_slips
+from harness.runs.observables import FLYING, HOPPING, SLIDING, observe, window, window_slips
 from harness.runs.run import simulate
 from harness.runs.settings import PRESETS, InitialCondition, ObservableSettings, PointSettings, RunSettings
 
@@ -150,8 +151,8 @@ def ramp_task(item: dict, pool) -> dict:
 
 # ---------------------------------------------------------------------- helpers
 def friction_held(regime: str) -> bool:
-    """Held by friction in the window: stick-slip, stuck or jammed (not sliding, not flying)."""
-    return regime not in (SLIDING, FLYING)
+    """Held by friction in the window: stick-slip, stuck or jammed (not sliding, hopping or flying)."""
+    return regime not in (SLIDING, HOPPING, FLYING)
 
 
 def first_sliding(values: Sequence[float], regimes: Sequence[str]) -> float | None:

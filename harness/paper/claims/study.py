@@ -72,6 +72,11 @@ class Resolution:
     # (quick and tiny: its 16 runs of >= 1.5 wavelengths, ~2 CPU-minutes, do not fit their budgets).
     ensemble_wavelengths: float = 3.0
     readings: bool = True      # measure C2, C5-C8 under every reading of the paper's equations
+    # The paper's Fig. 1c at the paper's own parameters (model A; empty: not drawn) and the
+    # complete stick-slip cycles each point's window holds.
+    fig1c_omegas: tuple = ()
+    fig1c_amplitudes: tuple = ()
+    fig1c_cycles: int = 2
 
 
 RESOLUTIONS = {
@@ -85,7 +90,9 @@ RESOLUTIONS = {
         c6_ratios=(14.29, 28.57), c6_stiffnesses=(0.5, 1.0, 2.0),
         c6_relative_omegas=(0.25, 0.5, 1.0, 1.5, 2.0, 3.0), c6_ramp=(5.0, 8.0, 11.0, 14.0, 17.0, 22.0, 30.0, 40.0),
         c6_ramp_step=8_000.0, c7_omegas=tuple(np.round(np.geomspace(0.1, 50.0, 10), 4)), contact_horizon=5_000.0,
-        c8_velocities=(1e-3, 1e-2, 0.1, 1.0, 10.0), c8_omegas=(0.1, 0.3, 1.0, 3.0, 10.0, 30.0)),
+        c8_velocities=(1e-3, 1e-2, 0.1, 1.0, 10.0), c8_omegas=(0.1, 0.3, 1.0, 3.0, 10.0, 30.0),
+        fig1c_omegas=tuple(np.round(np.geomspace(0.1, 1.0, 6), 4)),
+        fig1c_amplitudes=tuple(np.round(np.geomspace(0.3, 300.0, 6), 4))),
     "quick": Resolution(
         name="quick", horizon_a=14_000.0, c2_amplitudes=(0.0, 8.0, 15.0), c3_omegas=(0.1, 0.3, 1.0, 3.0),
         c3_amplitudes=(0.03, 0.3, 3.0, 30.0, 300.0), c4_gammas=(0.035, 0.07, 0.28),
@@ -100,7 +107,8 @@ RESOLUTIONS = {
         c4_gammas=(0.07, 0.28), c4_omegas=(0.25, 0.45), c4_step=3_000.0, b_horizon=8_000.0, b_amplitudes=(0.0, 5.0),
         c_horizon=3_000.0, c6_amplitudes=(3.0,), c6_omegas=(0.3, 14.0), c6_ratios=(14.29,), c6_stiffnesses=(1.0,),
         c6_relative_omegas=(0.5, 2.0), c6_ramp=(5.0, 30.0), c6_ramp_step=2_500.0, c7_omegas=(0.3, 14.0),
-        contact_horizon=2_500.0, c8_velocities=(10.0,), c8_omegas=(0.3,), ensemble_wavelengths=0.0),
+        contact_horizon=2_500.0, c8_velocities=(10.0,), c8_omegas=(0.3,), ensemble_wavelengths=0.0,
+        fig1c_omegas=(0.2,), fig1c_amplitudes=(0.3,), fig1c_cycles=1),
 }
 
 
@@ -221,7 +229,8 @@ class Claim:
     (Fig. 1b); ``draw(study, save)`` hands each figure to ``save(figure, file name)``.
     ``readings``: the readings of the paper's equations the claim is measured under
     (the first is the one its figures and main verdict row use); a claim the readings
-    cannot change has the default reading only."""
+    cannot change has the default reading only.  ``describe(measured) -> str``: what a
+    study without verdicts found, in one paragraph of the report."""
 
     name: str
     study: Callable[[Runner], Study]
@@ -230,6 +239,7 @@ class Claim:
     figures: dict = field(default_factory=dict)
     draw: Callable | None = None
     readings: tuple = (DEFAULT_READING,)
+    describe: Callable[[dict], str] | None = None
 
 
 def save_studies(studies: dict[str, Study], path: str | os.PathLike) -> None:

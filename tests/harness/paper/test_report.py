@@ -45,6 +45,13 @@ def test_tiny_main_job_writes_a_report_from_its_measurements(tiny_job):
                  "model_c_phase_diagram.png", "omega2_vs_k_n.png", "model_c_Vd_omega.png"):
         assert (out / name).stat().st_size > 0 and f"]({name})" in text
     assert "phi_threshold: 10" in text and "transient: 4000" in text
+    # The paper's Fig. 1c at the paper's own parameters: a sub-threshold point stick-slips
+    # with at least the window's cycles + 1 slips (vibration shortens the cycle, never lengthens it).
+    fig1c = studies["Fig1c"]
+    (point,) = fig1c.measured["points"]
+    assert point["regime"] == "stick_slip" and point["slips_in_window"] >= fig1c.settings["cycles"] + 1
+    assert (out / "fig1c_paper_parameters.png").stat().st_size > 0
+    assert "- Fig1c: 1 points" in text
 
 
 def test_changed_measurement_changes_the_report(tiny_job):

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from harness.runs.observables import (FLYING, JAMMED, SLIDING, STICK_SLIP, STUCK, classify, contact_fraction,
-                                      drift_velocity, observe, phi, slip_events, slope_angles, window)
+from harness.runs.observables import (FLYING, HOPPING, JAMMED, SLIDING, STICK_SLIP, STUCK, classify,
+                                      contact_fraction, drift_velocity, observe, phi, slip_events, slope_angles,
+                                      window)
 from harness.runs.settings import ObservableSettings
 
 V_D = 0.01
@@ -135,6 +136,10 @@ def test_contact_fraction_drift_and_classification():
     assert contact_fraction(ds, win) == pytest.approx(0.25, abs=2e-3)
     assert drift_velocity(ds, win) == pytest.approx(2 * V_D)
     assert classify(10.5, 10.0) == STICK_SLIP and classify(9.5, 10.0, 0.9 * V_D, V_D) == SLIDING
+    # Large phi without rests: hopping when mostly in the air, else by the drift.
+    assert classify(50.0, 10.0, V_D, V_D, rests=0.0, contact=0.1) == HOPPING
+    assert classify(50.0, 10.0, V_D, V_D, rests=0.5, contact=0.1) == STICK_SLIP  # sticks between bounces
+    assert classify(50.0, 10.0, V_D, V_D, rests=0.0, contact=0.9) == STICK_SLIP
     assert classify(1.0, 10.0, 0.01 * V_D, V_D) == STUCK
 
 
@@ -157,6 +162,47 @@ def test_a_block_that_never_touches_the_plate_is_flying_whatever_its_phi():
     in_contact = observe(dataset(t, vx, contact=np.ones_like(t, dtype=bool)), ObservableSettings(transient=0.0))
     airborne = observe(dataset(t, vx, contact=np.zeros_like(t, dtype=bool)), ObservableSettings(transient=0.0))
     assert in_contact.regime == STICK_SLIP and airborne.regime == FLYING
+
+
+def test_a_hopping_block_is_not_stick_slip_however_large_its_phi():
+    """Crest-to-crest hops: fast flights (vx swinging from 0 to 8 V_d every 31.4, the
+    mean following the drive), a landing 3 % of the time, never at rest over a hop."""
+    t = np.arange(0.0, 3000.0, 0.05)
+    hop = 31.4
+    phase = (t % hop) / hop
+    vx = V_D * (1.0 + 7.0 * np.sin(2 * math.pi * phase))
+    landed = phase > 0.97
+    ds = dataset(t, vx, contact=landed)
+    observed = observe(ds, ObservableSettings(transient=100.0))
+    assert observed.phi > 10.0  # the paper's order parameter alone would call it stick-slip
+    assert observed.regime == HOPPING and not observed.stick_slip
+    assert observed.rest_fraction < 0.1 and observed.contact_fraction == pytest.approx(0.03, abs=0.005)
+    # The same motion in contact half the time or more is judged by phi alone.
+    assert observe(dataset(t, vx, contact=phase > 0.4), ObservableSettings(transient=100.0)).regime == STICK_SLIP
+
+
+def test_a_block_mostly_in_contact_is_judged_by_phi_whatever_its_rests():
+    """Held with the tangential spring ringing through the stick (vx swinging by 5 V_d
+    while the block creeps at 3 % of V_d): never at rest by |vx|, yet in contact, so phi
+    decides, as in the paper (the module doc says why)."""
+    t = np.arange(0.0, 3000.0, 0.05)
+    vx = 0.03 * V_D + 5.0 * V_D * np.cos(0.53 * t)
+    ringing = observe(dataset(t, vx, contact=np.ones_like(t, dtype=bool)), ObservableSettings(transient=100.0))
+    assert ringing.phi > 10.0 and ringing.rest_fraction < 0.1 and ringing.regime == STICK_SLIP
+
+
+def test_stick_slip_locked_to_the_plate_period_is_stick_slip():
+    """Below the onset the Coulomb bound dips at each trough of N: the block sticks for
+    most of each plate period (omega = 0.1) and slips the rest, keeping up with the
+    drive on average.  It rests, so it is stick-slip, as phi says (not sliding)."""
+    omega, t = 0.1, np.arange(0.0, 6000.0, 0.1)
+    phase = (omega * t / (2 * math.pi)) % 1.0
+    period = 2 * math.pi / omega
+    burst = 0.1  # share of the period spent slipping
+    vx = np.where(phase < burst, V_D / burst * (1 - np.cos(2 * math.pi * phase / burst)), 0.0)
+    locked = observe(dataset(t, vx, contact=np.ones_like(t, dtype=bool)), ObservableSettings(transient=period))
+    assert locked.drift_velocity == pytest.approx(V_D, rel=0.02) and locked.phi > 10.0
+    assert locked.rest_fraction > 0.7 and locked.regime == STICK_SLIP
 
 
 def test_a_window_without_two_samples_is_refused():
