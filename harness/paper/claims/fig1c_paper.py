@@ -18,6 +18,7 @@ from harness.runs.settings import ObservableSettings, PointSettings
 
 from .measure import friction_held, observe_json, onset_amplitude, run_and_measure
 from .study import Claim, Runner, Study
+from .verdicts import fmt
 
 TEXT: dict = {}
 FIGURES: dict = {}
@@ -87,8 +88,8 @@ def describe(m: dict) -> str:
         lines = {"g/w^2": 1.0 / omega**2, "A_c": float(onset_amplitude(omega))}
         inside = [name for name, value in lines.items()
                   if (low is None or low <= value) and (high is None or value <= high)]
-        columns.append(f"w = {omega:.3g}: held up to A = {low if low is not None else '-'}, not from "
-                       f"{high if high is not None else '-'} ({', '.join(inside) or 'neither line'} inside; "
+        columns.append(f"w = {omega:.3g}: held up to A = {fmt(low)}, not from {fmt(high)} "
+                       f"({', '.join(inside) or 'neither line'} inside; "
                        f"{sum(h1 != h2 for h1, h2 in zip(held, held[1:]))} change(s) along A)")
     fewest = m["fewest_slips_at_stick_slip"]
     return (f"{len(m['points'])} points, cycle time T = {m['cycle_time']:.3g}; stick-slip points show at least "

@@ -25,8 +25,8 @@ def test_the_summary_brackets_each_column_and_names_the_lines_inside():
               for a in (0.3, 3.0, 30.0, 300.0) for w in (0.1, 1.0)]
     text = describe({"points": points, "cycle_time": 5e7, "fewest_slips_at_stick_slip": 3})
     assert "at least 3 slips" in text
-    assert "w = 0.1: held up to A = 30.0, not from 300.0 (g/w^2, A_c inside; 1 change(s) along A)" in text
+    assert "w = 0.1: held up to A = 30, not from 300 (g/w^2, A_c inside; 1 change(s) along A)" in text
     # At omega = 1 the onset A_c (0.07) lies below the bracket [0.3, 3]: only g/omega^2 is inside.
-    assert "w = 1: held up to A = 0.3, not from 3.0 (g/w^2 inside; 1 change(s) along A)" in text
+    assert "w = 1: held up to A = 0.3, not from 3 (g/w^2 inside; 1 change(s) along A)" in text
     assert describe({"points": [], "cycle_time": 5e7, "fewest_slips_at_stick_slip": None}) == \
         "not run at this resolution"
