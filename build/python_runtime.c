@@ -528,7 +528,7 @@ int python_slave_native_step(const PythonSlave* slave, double t, double h)
     if (!(now < end && end < INFINITY)) return 0;
     double target = floor((end - n->t0) / n->dt + n->grid_tolerance);
     double step = (double)n->cnt[n->step_slot];
-    if (!(target - step <= n->step_budget) || target >= 9.2e18) return 0;
+    if (!(target - step <= n->step_budget) || target >= 9.2e18) return 0;  /* (beyond int64: Python refuses) */
     if (target > step &&
         n->advance(n->flags, n->y, n->cnt, n->drv, n->prm, (int64_t)target - (int64_t)step, n->track_energy)
             != n->returned_ok)

@@ -50,7 +50,6 @@ class Block:
         # The run's time, and what a native front end needs to advance it (vibroblock.native).
         self._native = NativeStep(layout=LAYOUT, returned_ok=RETURNED_OK, step_slot=L.C_STEP,
                                   grid_tolerance=GRID_TOLERANCE, time=math.nan)
-        self._native_entry = None  # C address of the bound advance kernel, if a front end asked for one
         self._natively_driven = False
 
     # ------------------------------------------------------------------ settings
@@ -103,17 +102,17 @@ class Block:
         """Point the record at the bound kernel and arrays; ready once the run has started."""
         record = self._native
         record.ready = 0
-        if not self._natively_driven:
+        if not (self._natively_driven and self.started):
             return
         settings, kernel = self.settings, self._kernel
-        self._native_entry = entry_address(kernel.advance, settings.kind, kernel.id)
-        record.advance = self._native_entry
+        entry = entry_address(kernel.advance, settings.kind, kernel.id)
+        record.advance = entry
         record.flags = settings.scene_flags(self.frozen_released)
         record.y, record.cnt, record.drv, record.prm = (a.ctypes.data for a in (self.y, self.cnt, self.drv, self.prm))
         record.track_energy = int(self._track_energy)
         record.step_budget = self._step_budget
         record.t0, record.dt = self._grid
-        record.ready = int(self.started and self._native_entry is not None)
+        record.ready = int(entry is not None)
 
     def check_stability(self) -> None:
         self.settings.check(self.frozen_released)
