@@ -54,7 +54,7 @@ Definitions
   alpha = arctan(A_x omega_x cos(omega_x x)) of the surface under the block, in degrees,
   positive where it rises along +x (the drive's direction): at the window's last sample
   (where a jammed block sits) and the median over the window's samples at rest
-  (|vx| < V_d / 10: the stick sites).  Self-locking needs alpha >= arctan(1 / mu_s).
+  (as in the rest fraction: the stick sites).  Self-locking needs alpha >= arctan(1 / mu_s).
   NaN on a flat plate, or with no sample at rest.
 """
 from __future__ import annotations
@@ -171,7 +171,7 @@ def slope_angles(ds: xr.Dataset, win: Window) -> tuple[float, float]:
     part = win.slice()
     x, vx = ds["x"].values[part], ds["vx"].values[part]
     alpha = np.degrees(np.arctan(a_x * omega_x * np.cos(omega_x * x)))
-    at_rest = np.abs(vx) < 0.1 * abs(drive_velocity(ds))
+    at_rest = np.abs(vx) < REST_VELOCITY_FRACTION * abs(drive_velocity(ds))
     return float(alpha[-1]), float(np.median(alpha[at_rest])) if at_rest.any() else math.nan
 
 
