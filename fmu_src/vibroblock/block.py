@@ -255,11 +255,13 @@ class Block:
     @property
     def counters(self) -> dict[str, int]:
         """Cost counters of the run: grid steps, Coulomb resets, located events, rejected steps,
-        and the adaptive integrator's accepted internal steps and Jacobian evaluations."""
+        and the adaptive integrator's accepted internal steps, Jacobian evaluations and the
+        plate periods it crossed by stroboscopic jumps."""
         self._require_started()
         return {"steps": int(self.cnt[L.C_STEP]), "resets": int(self.cnt[L.C_SLIPS]),
                 "events": int(self.cnt[L.C_EVENTS]), "rejected": int(self.cnt[L.C_REJECTED]),
-                "accepted": int(self.cnt[L.C_ACCEPTED]), "jacobians": int(self.cnt[L.C_JACOBIANS])}
+                "accepted": int(self.cnt[L.C_ACCEPTED]), "jacobians": int(self.cnt[L.C_JACOBIANS]),
+                "periods_jumped": int(self.cnt[L.C_JUMPED])}
 
     def _observe(self):
         """The observation array (``layout.O_*``) at the current time."""

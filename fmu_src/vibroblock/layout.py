@@ -7,8 +7,8 @@ serialised whole (FMU state) and handed to compiled kernels without conversion.
 # Physical parameters, float64 array ``prm``: the slots every variant shares, then the
 # slots of the variants' own parameters (corrugation, confining force, ...), handed out
 # by ``slot`` in the order the variants are registered.
-COMMON_PRM_NAMES = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "rtol", "atol")
-P_M, P_G, P_KN, P_KT, P_GN, P_GT, P_MUS, P_KD, P_VD, P_RTOL, P_ATOL = range(len(COMMON_PRM_NAMES))
+COMMON_PRM_NAMES = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "rtol", "atol", "max_jump")
+P_M, P_G, P_KN, P_KT, P_GN, P_GT, P_MUS, P_KD, P_VD, P_RTOL, P_ATOL, P_MAX_JUMP = range(len(COMMON_PRM_NAMES))
 N_PRM = 24  # capacity: common slots + every registered variant's own parameters
 _PRM_SLOTS = {name: i for i, name in enumerate(COMMON_PRM_NAMES)}
 
@@ -40,9 +40,9 @@ N_Y = 11
 # last re-anchored (omega is tunable; the phase stays continuous when it changes), and
 # the cost counters of the integrators: located events (contact, detachment, reset),
 # rejected trial steps, and of an error-controlled integrator its accepted internal
-# steps and Jacobian evaluations.
-C_STEP, C_SLIPS, C_PHASE_STEP, C_EVENTS, C_REJECTED, C_ACCEPTED, C_JACOBIANS = range(7)
-N_CNT = 7
+# steps and Jacobian evaluations, and the plate periods it crossed by stroboscopic jumps.
+C_STEP, C_SLIPS, C_PHASE_STEP, C_EVENTS, C_REJECTED, C_ACCEPTED, C_JACOBIANS, C_JUMPED = range(8)
+N_CNT = 8
 
 # Clock and plate drive, float64 array ``drv``: start time, step, harmonic amplitude,
 # angular frequency, drive phase at C_PHASE_STEP, and the external plate input

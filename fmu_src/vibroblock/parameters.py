@@ -69,6 +69,9 @@ COMMON_PARAMETERS: tuple[Parameter, ...] = (
     Parameter("rtol", 1e-8, "1", "relative tolerance of the adaptive integrator's local error", POSITIVE),
     Parameter("atol", 1e-10, "delta_0, delta_0/tau_0", "absolute tolerance of the adaptive integrator's local error "
               "(lengths and velocities)", POSITIVE),
+    Parameter("max_jump", 1e12, "1", "most plate periods one stroboscopic jump of the adaptive integrator may span "
+              "while the block is held on a harmonically vibrating plate (below 4: every period resolved)",
+              NON_NEGATIVE),
     Parameter("x_start", 0.0, L, "initial horizontal position", FINITE),
     Parameter("z_start", 0.0, L, "initial height (used when initial_state = 1)", FINITE),
     Parameter("vx_start", 0.0, f"{L}/{T}", "initial horizontal velocity", FINITE),

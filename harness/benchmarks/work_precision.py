@@ -25,6 +25,12 @@ near a valley of their corrugation):
   Coulomb resets from the start, t = 300), ``sub-threshold`` (A = 0.2, omega = 0.8, t = 200,
   resets) and ``bouncing`` (A = 1, omega = 0.8, above the onset, t = 30, short enough to
   stay non-chaotic).
+* ``C held, vibrated (paper, fixed axes | tangent frame)``: model C at the paper's own
+  parameters held at a crest (slope 0) of its corrugation by friction on a plate vibrated
+  at omega = 0.316 with about a third of the detachment onset (A = 3), from the steady orbit,
+  for t = 2e4 (~1000 plate periods, no switch): the regime of the paper's long vibrated
+  sticks, where ``adaptive`` takes the periods many at a time (its stroboscopic jumps,
+  ``periods_jumped``).
 
 Integrators: the fixed-step ones over dt, ``event_driven`` (model A), ``adaptive`` over
 rtol (atol = rtol / 100).
@@ -63,6 +69,9 @@ PEERS = {"RK45": (1e-4, 1e-6, 1e-8, 1e-10), "DOP853": (1e-4, 1e-6, 1e-8, 1e-10),
 RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)  # adaptive's settings
 ADAPTIVE_DT = 1e-2  # its storage grid (no effect on accuracy)
 ACCURACY = 1e-6  # the equal-accuracy level of the targets
+CREST_X = 0.5 * math.pi / 0.02  # slope 0 at a crest of the paper's corrugation
+HELD_OMEGA = 0.316
+HELD_AMPLITUDE = 3.0  # about A_c(0.316) / 3 = 3.006 with the paper's contact (vibroblock.detachment_amplitude)
 
 
 @dataclass(frozen=True)
@@ -74,6 +83,7 @@ class Scenario:
     initial: int = 2
     x_start: float = 0.0
     window: tuple | None = None  # statistics window (chaotic scenarios)
+    formulation: int = 0
 
 
 SCENARIOS = (
@@ -90,6 +100,9 @@ SCENARIOS = (
           ("stick-slip", {}, 300.0, 0, -40.0),
           ("sub-threshold", dict(A=0.2, omega=0.8), 200.0, 2, 0.0),
           ("bouncing", dict(A=1.0, omega=0.8), 30.0, 2, 0.0))),
+    *(Scenario(f"C held, vibrated (paper, {name})", "C", dict(A=HELD_AMPLITUDE, omega=HELD_OMEGA), 2e4,
+               x_start=CREST_X, formulation=formulation)
+      for formulation, name in ((0, "fixed axes"), (1, "tangent frame"))),
 )
 
 
@@ -99,8 +112,9 @@ def core_run(scenario: Scenario, integrator: str, dt: float, **tolerances):
     from vibroblock import Block
 
     def make():
+        readings = {"formulation": scenario.formulation} if scenario.model != "A" else {}
         block = Block(scenario.model, integrator, dt=dt, initial_state=scenario.initial, x_start=scenario.x_start,
-                      energy_balance=True, **scenario.parameters, **tolerances)
+                      energy_balance=True, **scenario.parameters, **readings, **tolerances)
         block.start()
         return block
 
@@ -139,7 +153,7 @@ def scipy_run(scenario: Scenario, solver):
     else:
         times = np.array([scenario.horizon])
     run = reference.simulate(scenario.model, scenario.parameters, scenario.horizon, times, solver=solver,
-                             initial=scenario.initial, x_start=scenario.x_start)
+                             initial=scenario.initial, x_start=scenario.x_start, formulation=scenario.formulation)
     obs = {"x": run.final("x"), "z": run.final("z"), "phi": run.final("phi")}
     if scenario.window:
         span = scenario.window[1] - scenario.window[0]

@@ -64,6 +64,12 @@ regimes the surface's (``dynamics.surface_contact``), the flight regime the fixe
 regime.  The tangent frame with free flight is refused for every integrator (no position
 in the plane, docs/physics.md Sec. 6).
 
+Stroboscopic jumps.  While the block is held (regime loaded) on a plate that moves
+harmonically, whole plate periods are taken many at a time through the period map's
+affine model, with error control per period crossed and a hand-back to resolved steps
+before any switch (the section "stroboscopic jumps" below; ``max_jump`` bounds a jump,
+below STROBE_MIN it turns them off; ``cnt[C_JUMPED]`` counts the periods crossed).
+
 Grid.  As ``event_driven``: dt only sets the grid on which the state is stored; a call
 integrates from t0 + n dt to t0 + (n + n_steps) dt.  Splits agree to the tolerances
 (the step sequence depends on where a run stops), not bit for bit.
@@ -76,10 +82,10 @@ from numba import literally, njit
 
 from ..dynamics import contact, coulomb_bound, energy_rates, force, plate_motion, position_rates, surface_contact
 from .fixed_step import kahan_add, record_observation
-from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_PHASE_STEP, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
-                      D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, P_ATOL, P_GN, P_KN, P_KT,
-                      P_M, P_MUS, P_RTOL, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK,
-                      Y_X, Y_Z)
+from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_PHASE_STEP, C_REJECTED, C_SLIPS, C_STEP,
+                      D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, P_ATOL, P_GN,
+                      P_KD, P_KN, P_KT, P_M, P_MAX_JUMP, P_MUS, P_RTOL, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI,
+                      Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..readings import free_flight
 
 # Statuses (negative: failure, the arrays untouched).
@@ -399,6 +405,316 @@ def _dense(v, out, k, s, res):
         res[i] = (1.0 - s) * v[i] + s * (out[i] + (1.0 - s) * (w2 + s * w3))
 
 
+# --------------------------------------------------------------------------- stroboscopic jumps
+# A block held by friction on a harmonically vibrating plate settles on an orbit that
+# repeats every plate period while the slow variables (the spring's stretch, the
+# tangential spring, the position along the corrugation) creep: at the paper's
+# parameters a stick lasts 1e7-1e9 periods, and resolving each costs ~16-30 steps.  The
+# map over one period, P(y, D) (D the drive's far end, V_d t), is then nearly affine: the
+# contact and spring forces are linear in the state, only the surface's slope moves with
+# x, and that by little per period.  So from y_0 the periods are taken K at a time:
+#   delta_{n+1} = M delta_n + r + n q,   delta_n = y_n - y_0,
+# with r = P(y_0, D_0) - y_0 from one resolved period (whose step sequence is recorded),
+# M = dP/dy and q = V_d T dP/dD from replays of that sequence on perturbed starts (finite
+# differences that share every step, so they carry no step-selection noise), and the
+# quadratures (phi, energies) summed along with the same linear model.  Ringing modes
+# that have not died are carried exactly by M^n (they are linear); K periods cost
+# log2(K) products of 11 x 11 matrices.
+#
+# Error control.  The state a jump lands on is checked by replaying the same step
+# sequence from it: the increment of that period against the linear model's prediction
+# (the model's error grows along the jump, so K/3 times that discrepancy bounds what the
+# jump accumulated) must stay within rtol/atol, else the jump is retaken shorter.  The
+# replay is the next jump's resolved period.  Events: each event value's minimum over the
+# resolved period (its margin) is watched; a jump may use up at most STROBE_MARGIN of any
+# margin at the rate the last jump showed, and a period whose replay meets an event, or a
+# jump allowed fewer than STROBE_MIN periods, hands back to resolved stepping, which
+# locates the switch on its own step.  (Issue 10; DESIGN Sec. 3: envelope following.)
+STROBE_MIN = 4          # fewest periods a jump spans
+STROBE_FIRST = 8        # the first jump of a session, before a margin's rate is known
+STROBE_GROW = 8.0       # largest growth of the jump from one jump to the next
+STROBE_MARGIN = 0.5     # largest fraction of an event's margin one jump may use up
+STROBE_STEPS = 2048     # steps the recorded period may hold
+STROBE_KEEP = 0.5       # a model whose landing was checked within this fraction of the tolerance is kept
+STROBE_WAIT = 2         # periods of resolved stepping before the next try, doubled after each failed try
+STROBE_WAIT_MAX = 1024
+STROBE_EPS = 1e-6       # relative perturbation of the state's finite differences
+STROBE_PULL = 1e-4      # change of the drive's pull (k_d times its far end's shift) of the drive's difference
+NA = NV + 2             # affine model on (delta, quadratures, 1, n)
+
+
+@njit(cache=True)
+def _period(kind, regime, v0, t_abs, shift, drv, cnt, n0, u, period, cap, h_first, prm, track_energy, hs, n_hs,
+            out, margins, scale, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch):
+    """One plate period from v0 (quadratures of v0 are 0): with n_hs = 0 by error-controlled
+    steps whose lengths are recorded in hs, else by replaying hs[:n_hs].  ``shift`` moves
+    the drive's far end (the time the forces see, not the plate's).  Writes the end state
+    and the period's quadrature increments to ``out``, each event value's minimum over the
+    step ends and interpolant samples to ``margins``, and each state component's largest
+    magnitude at the step ends to ``scale`` (the orbit's size, for the error weights).
+    Returns the number of steps, or -1 if an event value went negative or a step failed."""
+    n_events = _events_of(regime)[1]
+    for i in range(NV):
+        out[i] = 0.0
+        probe[i] = v0[i]
+    pz, pv = _plate(drv, cnt, n0, u)
+    for e in range(n_events):
+        margins[e] = _value(kind, regime, e, v0, t_abs + shift, pz, pv, prm)
+        if margins[e] <= 0.0:
+            return -1
+    for i in range(NS):
+        scale[i] = abs(v0[i])
+    record = n_hs == 0
+    local = 0.0
+    h = min(h_first, cap, period)
+    steps = 0
+    while True:
+        if record:
+            if local >= period:
+                break
+            if steps >= STROBE_STEPS:
+                return -1
+            h = min(h, period - local)
+        else:
+            if steps >= n_hs:
+                break
+            h = hs[steps]
+        _linearise(kind, regime, probe, t_abs + shift + local, drv, cnt, n0, u + local, prm, track_energy, f0, jac,
+                   ft, scratch)
+        tally[2] += 1
+        err = _rosenbrock(kind, regime, probe, t_abs + shift + local, drv, cnt, n0, u + local, h, prm, track_energy,
+                          f0, jac, ft, lu, piv, k, stage, rate, trial)
+        if record and not err <= 1.0:
+            tally[1] += 1
+            h *= SHRINK if not math.isfinite(err) else max(SHRINK, SAFETY * err ** -0.25)
+            if h <= 16.0 * EPS * max(1.0, abs(t_abs + local)):
+                return -1
+            continue
+        if not math.isfinite(err):
+            return -1
+        tally[0] += 1
+        for sample in range(1, EVENT_SAMPLES + 1):
+            s = sample / EVENT_SAMPLES
+            if sample == EVENT_SAMPLES:
+                for i in range(NS):
+                    scratch[0, i] = trial[i]
+            else:
+                _dense(probe, trial, k, s, scratch[0])
+            pz, pv = _plate(drv, cnt, n0, u + local + s * h)
+            for e in range(n_events):
+                g = _value(kind, regime, e, scratch[0], t_abs + shift + local + s * h, pz, pv, prm)
+                if g <= 0.0:
+                    return -1
+                margins[e] = min(margins[e], g)
+        for i in range(NS):
+            probe[i] = trial[i]
+            scale[i] = max(scale[i], abs(trial[i]))
+        for i in range(NS, NV):
+            out[i] += trial[i]
+        local += h
+        if record:
+            hs[steps] = h
+            h = min(h * min(GROW, max(SHRINK, SAFETY * (max(err, 1e-12) ** -0.25))), cap)
+        steps += 1
+    for i in range(NS):
+        out[i] = probe[i]
+    return steps
+
+
+@njit(cache=True)
+def _affine_power(g, power, vec, sq, tmp):
+    """vec <- g^power vec (binary powering; g is overwritten by its squares)."""
+    while power > 0:
+        if power & 1:
+            for i in range(NA):
+                acc = 0.0
+                for j in range(NA):
+                    acc += g[i, j] * vec[j]
+                tmp[i] = acc
+            for i in range(NA):
+                vec[i] = tmp[i]
+        power >>= 1
+        if power == 0:
+            break
+        for i in range(NA):
+            for j in range(NA):
+                acc = 0.0
+                for l in range(NA):
+                    acc += g[i, l] * g[l, j]
+                sq[i, j] = acc
+        for i in range(NA):
+            for j in range(NA):
+                g[i, j] = sq[i, j]
+
+
+@njit(cache=True)
+def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h_first, prm, track_energy, dq,
+                  tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch):
+    """Take the plate periods from local time u K at a time while the block stays in the
+    ``regime`` (LOADED) without a switch (the section's comment above).  Moves v (state
+    slots) and returns the new local time (u if no jump was taken); dq gets the
+    quadratures' increments, tally (accepted, rejected, Jacobians, periods jumped) the
+    costs."""
+    n_events = _events_of(regime)[1]
+    hs = np.empty(STROBE_STEPS)
+    y0 = np.zeros(NV)
+    base = np.zeros(NV)
+    moved = np.zeros(NV)
+    check = np.zeros(NV)
+    cols = np.zeros((NS + 1, NV))
+    margins = np.zeros(3)
+    margins_moved = np.zeros(3)
+    margins_before = np.zeros(3)
+    scale = np.zeros(NS)
+    scale_moved = np.zeros(NS)
+    g = np.zeros((NA, NA))
+    work = np.zeros((NA, NA))
+    sq = np.zeros((NA, NA))
+    vec = np.zeros(NA)
+    tmp = np.zeros(NA)
+    for i in range(4):
+        dq[i] = 0.0
+    for i in range(NS):
+        y0[i] = v[i]
+    n_hs = _period(kind, regime, y0, t_base + u, 0.0, drv, cnt, n0, u, period, cap, h_first, prm, track_energy, hs,
+                   0, base, margins, scale, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch)
+    if n_hs <= 0:
+        return u
+    rtol, atol, vd = prm[P_RTOL], prm[P_ATOL], prm[P_VD]
+    jump = float(STROBE_FIRST)
+    last_jump = 0.0
+    model_current = False  # cols hold dP/dy, dP/dD taken at this or an earlier y0
+    model_fresh = False  # ... taken at this y0
+    while True:
+        t_abs = t_base + u
+        if model_current:
+            model_fresh = False
+        else:
+            model_current = model_fresh = True
+        # The linear model at y0: columns of dP/dy and dP/dD by replays of hs, central
+        # differences (the slope's dependence on x makes one-sided ones biased).  They
+        # change slowly along a stick, so a model that predicted the last landing well is
+        # kept (only r = P(y0) - y0 is new, from the landing's replay).
+        for j in range(NS if model_fresh else 0):
+            for i in range(NV):
+                cols[j, i] = 0.0
+            step = STROBE_EPS * max(1.0, abs(y0[j]))
+            for side in range(2):
+                for i in range(NV):
+                    moved[i] = y0[i]
+                moved[j] = y0[j] + step if side == 0 else y0[j] - step
+                if _period(kind, regime, moved, t_abs, 0.0, drv, cnt, n0, u, period, cap, h_first, prm,
+                           track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0, jac, ft, lu, piv, k,
+                           stage, rate, trial, probe, scratch) < 0:
+                    return u
+                for i in range(NV):
+                    if side == 0:
+                        cols[j, i] = check[i]
+                    else:
+                        cols[j, i] = (cols[j, i] - check[i]) / (2.0 * step)
+        for i in range(NV if model_fresh else 0):
+            cols[NS, i] = 0.0
+        if model_fresh and vd != 0.0 and prm[P_KD] > 0.0:
+            # The pull is linear in the far end's position: a shift the finite difference
+            # resolves far above the rounding of the positions (k_d is ~1e-6 at the paper's),
+            # taken both ways so that the quadratures (quadratic in the velocities) lose
+            # their second-order term.
+            shift = STROBE_PULL / (prm[P_KD] * abs(vd))
+            for side in range(2):
+                sign = 1.0 if side == 0 else -1.0
+                if _period(kind, regime, y0, t_abs, sign * shift, drv, cnt, n0, u, period, cap, h_first, prm,
+                           track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0, jac, ft, lu, piv, k,
+                           stage, rate, trial, probe, scratch) < 0:
+                    return u
+                for i in range(NV):
+                    cols[NS, i] += sign * check[i] * period / (2.0 * shift)  # per period of drive travel
+        while True:
+            # The jump's length: the call's end, and each margin at the rate the last jump used it up.
+            room = math.floor((u_end - u) / period) - 1.0
+            allowed = min(jump, room, math.floor(prm[P_MAX_JUMP]))
+            if last_jump > 0.0:
+                for e in range(n_events):
+                    rate_e = (margins_before[e] - margins[e]) / last_jump
+                    if rate_e > 0.0:
+                        allowed = min(allowed, math.floor(STROBE_MARGIN * margins[e] / rate_e))
+            if allowed < STROBE_MIN:
+                return u
+            count = int(allowed)
+            # g: the one-period map of (delta, quadratures, 1, n).
+            # delta' = M delta + r + n q; quadratures' = quadratures + (their rows of M) delta + r + n q
+            for i in range(NA):
+                for j in range(NA):
+                    g[i, j] = 0.0
+            for i in range(NV):
+                for j in range(NS):
+                    g[i, j] = cols[j, i]
+                if i >= NS:
+                    g[i, i] = 1.0
+                g[i, NV] = base[i] - y0[i] if i < NS else base[i]
+                g[i, NV + 1] = cols[NS, i]
+            g[NV, NV] = 1.0
+            g[NV + 1, NV] = 1.0
+            g[NV + 1, NV + 1] = 1.0
+            for i in range(NA):
+                vec[i] = 0.0
+                for j in range(NA):
+                    work[i, j] = g[i, j]
+            vec[NV] = 1.0
+            _affine_power(work, count, vec, sq, tmp)
+            for i in range(NS):
+                moved[i] = y0[i] + vec[i]
+            for i in range(NS, NV):
+                moved[i] = 0.0
+            ok = math.isfinite(vec[0] + vec[1] + vec[2] + vec[3] + vec[4] + vec[5])
+            steps = -1
+            if ok:
+                steps = _period(kind, regime, moved, t_abs + count * period, 0.0, drv, cnt, n0, u + count * period,
+                                period, cap, h_first, prm, track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0,
+                                jac, ft, lu, piv, k, stage, rate, trial, probe, scratch)
+            err = math.inf
+            if steps > 0:
+                # The landed period's increment against the model's, r + (M - I) delta_K + K q,
+                # within the tolerances: error per period crossed, as a resolved period's steps
+                # are held to theirs (the rounding of the plate's phase and of the positions sets
+                # a floor of ~1e-12 per period that no jump length can get under).  The quadratures
+                # ride along uncontrolled, as in a step.
+                err = 0.0
+                for i in range(NS):
+                    predicted = base[i] - y0[i] + cols[NS, i] * count
+                    for j in range(NS):
+                        predicted += (cols[j, i] - (1.0 if i == j else 0.0)) * vec[j]
+                    weight = atol + rtol * max(abs(y0[i]), abs(moved[i]), scale[i])
+                    e = (check[i] - moved[i] - predicted) / weight
+                    err += e * e
+                err = math.sqrt(err / NS)
+            if err <= 1.0 or not model_fresh:
+                break
+            # Retake it shorter (the model at y0 stands); an event met right after the
+            # jump may have happened within it.
+            jump = count * (0.25 if not math.isfinite(err) else max(0.1, min(0.5, 0.8 * err ** -0.5)))
+        if not err <= 1.0:
+            model_current = False  # a kept model failed: take it afresh at y0 and try again
+            continue
+        # Accept: the landed state, and its replayed period as the next model's base.
+        u += count * period
+        tally[3] += count
+        for i in range(NS):
+            y0[i] = moved[i]
+            v[i] = moved[i]
+        for i in range(4):
+            dq[i] += vec[NS + i]
+        for i in range(NV):
+            base[i] = check[i]
+        for e in range(n_events):
+            margins_before[e] = margins[e]
+            margins[e] = margins_moved[e]
+        for i in range(NS):
+            scale[i] = scale_moved[i]
+        last_jump = float(count)
+        jump = count * min(STROBE_GROW, max(1.0, 0.8 * max(err, 1e-12) ** -0.5))
+        model_current = err <= STROBE_KEEP
+
+
 # --------------------------------------------------------------------------- regimes
 @njit(inline="always")
 def _regime_after_contact(bound):
@@ -409,7 +725,7 @@ def _regime_after_contact(bound):
 def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     """Integrate from grid step n0 (state y) over local time u_end.  Writes the final state
     to ``out`` (layout of y), the slip count to costs[0] and the cost counters (accepted,
-    rejected, events, Jacobians) to costs[1:5].  Returns OK or a negative status."""
+    rejected, events, Jacobians, periods jumped) to costs[1:6].  Returns OK or a negative status."""
     kt = prm[P_KT]
     half_kt = 0.5 * kt
     t_base = drv[D_T0] + n0 * drv[D_DT]
@@ -419,6 +735,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     work_sum, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
     slips = cnt[C_SLIPS]
     accepted = rejected = events = jacobians = 0
+    jumped = 0
 
     f0 = np.zeros(NV)
     ft = np.zeros(NV)
@@ -452,6 +769,14 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     cap = math.inf
     if drv[D_OMEGA] > 0.0 and drv[D_AMP] != 0.0:
         cap = CYCLE_FRACTION * 2.0 * math.pi / drv[D_OMEGA]
+    # Stroboscopic jumps need a plate that repeats: the harmonic drive, the external input at rest.
+    period = 0.0
+    if cap < math.inf and drv[D_EXT_V] == 0.0 and drv[D_EXT_A] == 0.0 and prm[P_MAX_JUMP] >= STROBE_MIN:
+        period = 2.0 * math.pi / drv[D_OMEGA]
+    strobe_next = 0.0
+    strobe_wait = STROBE_WAIT
+    dq = np.zeros(4)
+    tally = np.zeros(4, dtype=np.int64)
     rtol = prm[P_RTOL]
     h = min(cap, 0.1 * rtol ** 0.25)
     u = 0.0
@@ -465,6 +790,30 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             status = TOO_MANY_STEPS
             break
         t_abs = t_base + u
+        if period > 0.0 and regime == LOADED and u >= strobe_next and u_end - u >= (STROBE_MIN + 2) * period:
+            tally[:] = 0
+            u_jumped = _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h, prm,
+                                     track_energy, dq, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe,
+                                     scratch)
+            accepted += tally[0]
+            rejected += tally[1]
+            jacobians += tally[2]
+            jumped += tally[3]
+            if u_jumped > u:
+                u = u_jumped
+                phi, phi_c = kahan_add(phi, phi_c, dq[0])
+                work_sum += dq[1]
+                dissipated += dq[2]
+                e_normal += dq[3]
+                fresh = False
+                strobe_wait = STROBE_WAIT
+                if not math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4]):
+                    status = NON_FINITE
+                    break
+            else:
+                strobe_wait = min(2 * strobe_wait, STROBE_WAIT_MAX)
+            strobe_next = u + strobe_wait * period
+            continue
         if not fresh:
             _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, jac, ft, scratch)
             jacobians += 1
@@ -685,7 +1034,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F] = v[0], v[1], v[2], v[3], v[4]
     out[Y_PHI], out[Y_PHI_C] = phi, phi_c
     out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL] = work_sum, dissipated, e_normal
-    costs[0], costs[1], costs[2], costs[3], costs[4] = slips, accepted, rejected, events, jacobians
+    costs[0], costs[1], costs[2], costs[3], costs[4], costs[5] = slips, accepted, rejected, events, jacobians, jumped
     return status
 
 
@@ -696,7 +1045,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     Returns 0, or a negative status with the arrays untouched."""
     kind = literally(kind)
     out = y.copy()
-    costs = np.zeros(5, dtype=np.int64)
+    costs = np.zeros(6, dtype=np.int64)
     n = cnt[C_STEP]
     status = _evolve(kind, y, cnt, drv, prm, n, n_steps * drv[D_DT], track_energy, out, costs)
     if status < 0:
@@ -708,6 +1057,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     cnt[C_REJECTED] += costs[2]
     cnt[C_EVENTS] += costs[3]
     cnt[C_JACOBIANS] += costs[4]
+    cnt[C_JUMPED] += costs[5]
     return status
 
 
@@ -718,7 +1068,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     kind = literally(kind)
     n = cnt[C_STEP]
     out = y.copy()
-    costs = np.zeros(5, dtype=np.int64)
+    costs = np.zeros(6, dtype=np.int64)
     slips = cnt[C_SLIPS]
     if h > 0.0:
         status = _evolve(kind, y, cnt, drv, prm, n, h, track_energy, out, costs)

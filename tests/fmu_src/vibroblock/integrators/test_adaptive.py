@@ -221,3 +221,63 @@ def test_energy_balance_closes_in_the_tangent_frame(model, coulomb_normal):
     out = block.outputs()
     assert out["energy_dissipated"] > 0.1 and out["slip_count"] > 0 and block.counters["events"] >= 4
     assert np.max(np.abs(residuals)) < 1e-8 * max(1.0, out["energy_dissipated"])
+
+
+CREST_X = 0.5 * math.pi / 0.02  # a crest of the paper's corrugation (slope 0)
+
+
+def _vibrated_stick(model, max_jump, horizon, **keywords):
+    """Model B or C at the paper's parameters held at a crest on a plate vibrated at a third
+    of the detachment onset (no switch within the horizon), from the steady orbit."""
+    from vibroblock import defaults, detachment_amplitude
+    p = defaults(model)
+    omega = 0.316
+    amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
+    block = Block(model, "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=CREST_X, dt=1.0,
+                  max_jump=max_jump, **keywords)
+    t0 = CREST_X / p["V_d"]
+    block.start(t0)
+    block.advance_to(t0 + horizon)
+    return block
+
+
+@pytest.mark.parametrize("model", ["C"])
+def test_stroboscopic_jumps_agree_with_every_period_resolved(model):
+    """The held block's periods taken hundreds at a time agree with every period resolved at a
+    tighter tolerance (an independent step sequence), and cost a small fraction of the steps."""
+    horizon = 2e4  # ~1000 plate periods
+    reference_run = _vibrated_stick(model, 0.0, horizon, formulation=1, rtol=1e-10, atol=1e-12)
+    resolved = _vibrated_stick(model, 0.0, horizon, formulation=1)
+    jumped = _vibrated_stick(model, 1e12, horizon, formulation=1)
+    ref = reference_run.outputs()
+    assert reference_run.counters["periods_jumped"] == resolved.counters["periods_jumped"] == 0
+    assert jumped.counters["periods_jumped"] > 900
+    assert jumped.counters["accepted"] < resolved.counters["accepted"] / 3
+    out = jumped.outputs()
+    assert out["slip_count"] == ref["slip_count"] == 0 and out["contact"]
+    assert abs(out["x"] - ref["x"]) <= 1e-8 * abs(ref["x"]) + 1e-6
+    assert abs(out["friction_force"] - ref["friction_force"]) <= 1e-9
+    assert abs(out["vx"] - ref["vx"]) <= 1e-9 and abs(out["vz"] - ref["vz"]) <= 1e-8
+    assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-6 * ref["phi_integral"]
+
+
+def test_stroboscopic_jumps_stop_before_the_slip_they_would_cross():
+    """A jump never crosses a switch: the slip that ends a vibrated stick of model A comes at
+    the time every period resolved gives (event_driven as the independent reference)."""
+    parameters = dict(SCALED, A=0.5, omega=0.5)
+    runs = {}
+    for name, keywords in (("event_driven", {}), ("adaptive", {"rtol": 1e-10, "atol": 1e-12})):
+        block = Block("A", name, initial_state=2, dt=1e-2, **parameters, **keywords)
+        block.start()
+        slips_at = []
+        last = 0
+        for step in range(1, 81):  # 100 tau_0 a call: ~8 plate periods, room for a jump
+            block.advance_to(step * 100.0)
+            count = block.output("slip_count")
+            if count > last:
+                slips_at.append(step * 100.0)
+                last = count
+        runs[name] = (block, slips_at)
+    jumped = runs["adaptive"][0].counters["periods_jumped"]
+    assert jumped > 0
+    assert runs["adaptive"][1][:3] == runs["event_driven"][1][:3] and len(runs["event_driven"][1]) >= 2
