@@ -676,17 +676,21 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
                 # The landed period's increment against the model's, r + (M - I) delta_K + K q,
                 # within the tolerances: error per period crossed, as a resolved period's steps
                 # are held to theirs (the rounding of the plate's phase and of the positions sets
-                # a floor of ~1e-12 per period that no jump length can get under).  The quadratures
-                # ride along uncontrolled, as in a step.
+                # a floor of ~1e-12 per period that no jump length can get under).  phi's
+                # increment too, relative to a period's: it is quadratic in the velocities, so a
+                # ringing that the jump carries linearly shows there first.
                 err = 0.0
-                for i in range(NS):
-                    predicted = base[i] - y0[i] + cols[NS, i] * count
+                for i in range(NS + 1):
+                    predicted = (base[i] - y0[i] if i < NS else base[i]) + cols[NS, i] * count
                     for j in range(NS):
                         predicted += (cols[j, i] - (1.0 if i == j else 0.0)) * vec[j]
-                    weight = atol + rtol * max(abs(y0[i]), abs(moved[i]), scale[i])
-                    e = (check[i] - moved[i] - predicted) / weight
+                    if i < NS:
+                        weight = atol + rtol * max(abs(y0[i]), abs(moved[i]), scale[i])
+                        e = (check[i] - moved[i] - predicted) / weight
+                    else:
+                        e = (check[i] - predicted) / (rtol * (abs(base[i]) + vd * vd * period) + 1e-300)
                     err += e * e
-                err = math.sqrt(err / NS)
+                err = math.sqrt(err / (NS + 1))
             if err <= 1.0 or not model_fresh:
                 break
             # Retake it shorter (the model at y0 stands); an event met right after the
