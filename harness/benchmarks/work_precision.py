@@ -184,7 +184,7 @@ def accuracy(scenario: Scenario, err: dict) -> float:
 
 # ----------------------------------------------------------------------------- measuring
 def measure(scenario: Scenario, quick: bool, log):
-    from vibroblock import INTEGRATORS
+    from vibroblock import INTEGRATORS, ModelError
 
     from harness.paper.reference import Solver
 
@@ -206,7 +206,11 @@ def measure(scenario: Scenario, quick: bool, log):
         else:
             runs = [(f"dt {dt:g}", dt, {}) for dt in ((STEPS[2],) if integrator == "event_driven" else steps)]
         for setting, dt, tolerances in runs:
-            seconds, obs = core_run(scenario, integrator, dt, **tolerances)
+            try:
+                seconds, obs = core_run(scenario, integrator, dt, **tolerances)
+            except ModelError as exc:  # e.g. a reading the integrator does not run
+                log(f"  {integrator:17s} {setting:13s} refused: {exc}")
+                break
             err = errors(scenario, obs, ref)
             rows.append((integrator, setting, seconds, accuracy(scenario, err), err))
             log(f"  {integrator:17s} {setting:13s} {seconds:9.4f} s  error {accuracy(scenario, err):.2e}")

@@ -422,14 +422,15 @@ def _dense(v, out, k, s, res):
 # log2(K) products of 11 x 11 matrices.
 #
 # Error control.  The state a jump lands on is checked by replaying the same step
-# sequence from it: the increment of that period against the linear model's prediction
-# (the model's error grows along the jump, so K/3 times that discrepancy bounds what the
-# jump accumulated) must stay within rtol/atol, else the jump is retaken shorter.  The
-# replay is the next jump's resolved period.  Events: each event value's minimum over the
-# resolved period (its margin) is watched; a jump may use up at most STROBE_MARGIN of any
-# margin at the rate the last jump showed, and a period whose replay meets an event, or a
-# jump allowed fewer than STROBE_MIN periods, hands back to resolved stepping, which
-# locates the switch on its own step.  (Issue 10; DESIGN Sec. 3: envelope following.)
+# sequence from it: the increment of that period (state and phi) against the linear
+# model's prediction must stay within rtol/atol (error per period crossed), else the jump
+# is retaken shorter.  The replay is the next jump's resolved period, and a model that
+# predicted it well is kept for the next jump.  Events: each event value's minimum over
+# the resolved period (its margin) is watched; a jump may use up at most STROBE_MARGIN of
+# any margin at the rate the last jump showed, and a period whose replay meets an event,
+# or a jump allowed fewer than STROBE_MIN periods, hands back to resolved stepping, which
+# locates the switch on its own step.  (Envelope following, as for circuits driven by a
+# fast periodic source.)
 STROBE_MIN = 4          # fewest periods a jump spans
 STROBE_FIRST = 8        # the first jump of a session, before a margin's rate is known
 STROBE_GROW = 8.0       # largest growth of the jump from one jump to the next

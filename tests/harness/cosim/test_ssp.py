@@ -114,7 +114,11 @@ def test_a_record_file_given_as_string_plays_in_libcosim_and_fmpy_says_it_cannot
     a = run_ssp_libcosim(ssp, stop_time=250.0, step_size=0.25)
     b = run_ssp_libcosim(bundled, stop_time=250.0, step_size=0.25)
     assert np.max(np.abs(a["plate.plate_a"])) > 0.1
-    np.testing.assert_array_equal(a["plate.plate_a"], b["plate.plate_a"])
+    # The file holds the record processed here and now; the bundled one was processed when
+    # the FMU's data were made: the same samples up to the rounding of the processing's
+    # floating-point kernels on another CPU (seen: 4e-17 on peaks of 0.3).
+    np.testing.assert_allclose(a["plate.plate_a"], b["plate.plate_a"], rtol=1e-9,
+                               atol=1e-12 * np.max(np.abs(b["plate.plate_a"])))
     with pytest.raises(SspError, match="cannot set str values"):
         run_ssp_fmpy(ssp, stop_time=100.0, step_size=0.25)
 
