@@ -41,8 +41,8 @@ CORRUGATED_INTEGRATION = Integration("adaptive", switch=(("omega", 2.0), ("V_d",
 # max_jump = 0: every plate period resolved.  The studies' scaled-drive sticks last a few
 # hundred plate periods and start with the friction spring ringing, which keeps adaptive's
 # stroboscopic jumps off while it rings; their failed tries then cost without a jump to pay
-# for them (measured in the main job: C6's non-default readings ~160 s each with the jumps,
-# ~83 s without).
+# for them (C6's non-default readings took ~160 s each with the jumps in one main job,
+# ~83 s each in the README's recorded job without them).
 CORRUGATED_TOLERANCES = {"rtol": 1e-6, "atol": 1e-8, "max_jump": 0.0}
 
 
