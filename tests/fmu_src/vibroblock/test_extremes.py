@@ -117,6 +117,32 @@ def test_a_horizon_of_1e9_runs_with_a_scheme_that_can_take_it():
     assert abs(out["energy_residual"]) < 1e-8 * out["energy_dissipated"]
 
 
+def test_a_vibrated_corrugated_horizon_of_1e9_runs_with_adaptive():
+    """Model C at the paper's own parameters on its vibrated corrugated plate (omega = 0.316,
+    a third of the detachment onset, tangent frame), held on a flank by friction, over 1e9
+    tau_0 with adaptive in communication steps of 1e8 (one call of 1e9 would exceed the step
+    budget a call may hold its master for): the ~5e7 plate periods are crossed by
+    stroboscopic jumps and the run ends finite, with a closed energy balance and the time
+    exact."""
+    from vibroblock import defaults, detachment_amplitude
+    flank = 1.5 * math.pi / 0.02 + 10.0  # just past a valley of the paper's corrugation
+    omega = 0.316
+    amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
+    block = Block("C", "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=flank, dt=1e3,
+                  formulation=1, rtol=1e-6, atol=1e-8, energy_balance=True)
+    t0 = flank / defaults("C")["V_d"]  # the drive spring relaxed at the start
+    block.start(t0)
+    for k in range(1, 11):
+        block.advance_to(t0 + k * 1e8)
+    out = block.outputs()
+    assert block.time == t0 + 1e9
+    assert all(math.isfinite(float(value)) for value in out.values()), out
+    assert block.counters["periods_jumped"] > 0.99 * 1e9 * omega / (2.0 * math.pi)
+    assert out["slip_count"] == 0 and out["contact"] and abs(out["x"] - flank) < 1.0  # held throughout
+    assert out["energy_dissipated"] > 1e5  # the contact's dashpot, every plate period
+    assert abs(out["energy_residual"]) <= BOUND["adaptive"] * energy_scale(block), out
+
+
 def test_a_horizon_too_long_for_a_fixed_step_is_refused_at_once_with_its_cost():
     block = Block("A")
     block.start()
