@@ -7,7 +7,7 @@ import math
 
 from . import layout as L
 from .orbits import steady_orbit
-from .settings import Settings
+from .settings import ModelError, Settings
 
 
 def place(settings: Settings, prm, drv, y) -> bool:
@@ -34,9 +34,18 @@ def place(settings: Settings, prm, drv, y) -> bool:
     elif settings.initial_state == 1:
         y[L.Y_Z], y[L.Y_VZ] = p["z_start"], p["vz_start"]
     else:
-        offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+        offset, rate = _steady_orbit(p, weight, phase)
         y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
     return _place_for_scene(settings, prm, drv, y)
+
+
+def _steady_orbit(p, weight, phase):
+    """``orbits.steady_orbit`` for the run's parameters; a drive that has none is refused."""
+    try:
+        return steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+    except ValueError as exc:
+        raise ModelError(f"initial_state = 2 (steady_orbit): {exc}; start at rest or as given "
+                         f"(initial_state = 0 or 1), or give the contact some damping") from None
 
 
 def point_to_frame(variant, prm, x, z, vx, vz):
@@ -73,7 +82,7 @@ def _place_in_tangent_frame(settings: Settings, prm, y, weight, phase) -> None:
         z = height + zeta * math.sqrt(1.0 + slope * slope)  # h + zeta / cos a
         _, u, w = point_to_frame(variant, prm, x, z, p["vx_start"], p["vz_start"])
     elif settings.initial_state == 2:
-        offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+        offset, rate = _steady_orbit(p, weight, phase)
         zeta, w = plate_p + offset, plate_v + rate
     y[L.Y_Z], y[L.Y_VX], y[L.Y_VZ] = zeta, u, w
 
@@ -88,7 +97,7 @@ def _place_for_scene(settings: Settings, prm, drv, y) -> bool:
         height, slope = settings.variant.profile(y[L.Y_X], prm)
         y[L.Y_Z], y[L.Y_VZ] = plate_z + height, plate_v + slope * y[L.Y_VX]
     if settings.scene["frozen_vertical"]:
-        offset, rate = steady_orbit(p["m"], p["k_n"], p["gamma_n"], p["m"] * p["g"], p["A"], p["omega"], phase)
+        offset, rate = _steady_orbit(p, p["m"] * p["g"], phase)
         if offset >= 0.0:
             return False
         y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate

@@ -20,8 +20,14 @@ import numpy as np
 
 
 def orbit_response(m, k_n, gamma_n, amplitude, omega) -> complex:
-    """Complex amplitude R of the steady orbit's oscillation about -W/k_n."""
-    return m * amplitude * omega**2 / complex(k_n - m * omega**2, gamma_n * omega)
+    """Complex amplitude R of the steady orbit's oscillation about -W/k_n.  An undamped
+    contact driven at its own resonance has none (its oscillation grows without bound):
+    ValueError, saying so."""
+    denominator = complex(k_n - m * omega**2, gamma_n * omega)
+    if denominator == 0.0 and amplitude * omega != 0.0:
+        raise ValueError(f"no steady in-contact orbit: the undamped contact (gamma_n = 0) is driven at its "
+                         f"resonance omega = sqrt(k_n / m) = {omega:g}, where its oscillation grows without bound")
+    return m * amplitude * omega**2 / denominator if denominator != 0.0 else 0.0j
 
 
 def steady_orbit(m, k_n, gamma_n, weight, amplitude, omega, phase):

@@ -94,6 +94,17 @@ def _no_limit(p: dict, model: str, name: str) -> str | None:
     return None
 
 
+def _undamped_resonance(p: dict, model: str, name: str) -> str | None:
+    """event_driven's contact flow is the driven oscillator's closed form, whose particular
+    solution divides by k_n - m omega^2 + i gamma_n omega: an undamped contact driven at its
+    own resonance has none (the secular solution grows like t), so it is refused up front."""
+    if p["gamma_n"] == 0.0 and p["A"] * p["omega"] != 0.0 and p["k_n"] == p["m"] * p["omega"] ** 2:
+        return (f"{name} cannot drive an undamped contact (gamma_n = 0) at its own resonance omega = sqrt(k_n / m) "
+                f"= {p['omega']:g}: its closed-form contact flow has no steady part there (the oscillation grows "
+                f"without bound); give gamma_n > 0, another omega, or use adaptive")
+    return None
+
+
 # Tolerances the adaptive integrator accepts: below RTOL_MIN the local error cannot be
 # told from rounding; above RTOL_MAX the error estimate no longer bounds anything.
 RTOL_MIN, RTOL_MAX = 1e-13, 1e-2
@@ -220,7 +231,7 @@ _RECORDS = (
     _fixed_step(1, "rk4", rk4, summary="classical fourth-order Runge-Kutta", models="*", force_evaluations=4,
                 check_step=_spring_dashpot_limit(4.0)),
     Integrator(2, "event_driven", "exact flows with located events (model A only)", models="A",
-               force_evaluations=0, check_step=_no_limit, advance=event_driven.advance,
+               force_evaluations=0, check_step=_undamped_resonance, advance=event_driven.advance,
                observe=event_driven.observe, splits_bitwise=False,
                unsupported_reading=lambda r: (
                    "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 "

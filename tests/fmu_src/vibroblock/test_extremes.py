@@ -6,7 +6,8 @@ energy + |work input| + the energy stored at the end (kinetic, normal spring, dr
 spring): the dissipated energy alone is no scale when nothing dissipates (gamma -> 0, a
 block at rest).  Bounds: implicit_contact 1e-4 (second order, exact contact flows; the
 worst case here, 1.6e-5, is the 89 degree corrugation with k_n = 1e8, and it falls 4x
-per halving of dt), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), adaptive 1e-4 (at
+per halving of dt), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), event_driven 1e-9
+(exact flows: the worst case, 2e-12, is V_d = 1e3), adaptive 1e-4 (at
 its default rtol = 1e-8; the worst case, 3.4e-5, is gamma_n = 1e4: the quadratures ride along
 without error control, and the stiff dashpot's dissipation is where that shows).  With k_n = 1e8 at rest on the paper's
 87 degree corrugation adaptive finishes (B slides down the flank and bounces in the valley:
@@ -30,7 +31,7 @@ from fmu_testing import do_step, fmu_log  # noqa: F401 (fixture)
 from vibroblock import Block, ModelError
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
-BOUND = {"symplectic_euler": 2e-2, "rk4": 1e-6, "implicit_contact": 1e-4, "adaptive": 1e-4}
+BOUND = {"symplectic_euler": 2e-2, "rk4": 1e-6, "implicit_contact": 1e-4, "adaptive": 1e-4, "event_driven": 1e-9}
 HORIZON = 100.0
 
 REFUSED_STEP = r"too large for the .* use dt <="  # an explicit scheme's stability limit, with the admissible dt
@@ -40,7 +41,8 @@ TOO_FAST = r"crosses the corrugation too fast for dt"
 EXPLICIT_REFUSE = {"symplectic_euler": REFUSED_STEP, "rk4": REFUSED_STEP, "implicit_contact": None}
 ALL_RUN = {"symplectic_euler": None, "rk4": None, "implicit_contact": None}
 MATRIX = {
-    # (every case below also runs adaptive, at its default tolerances; see ``matrix_cases``)
+    # (every case below also runs adaptive at its default tolerances, and event_driven on model A;
+    # see ``matrix_cases``)
     "k_n/m = 1e8, at rest": ("A", {"k_n": 1e8}, EXPLICIT_REFUSE),
     "k_n/m = 1e8, at rest, corrugated": ("BC", {"k_n": 1e8}, EXPLICIT_REFUSE),
     "k_n/m = 1e8, bouncing (A omega^2 = 2 g)": ("ABC", {"k_n": 1e8, "A": 2.0, "omega": 1.0},
@@ -71,7 +73,8 @@ def energy_scale(block: Block) -> float:
 def matrix_cases():
     for case, (models, parameters, expected) in MATRIX.items():
         for model in models:
-            for integrator, error in {**expected, "adaptive": expected.get("adaptive")}.items():
+            exact = {"event_driven": expected.get("event_driven")} if model == "A" else {}
+            for integrator, error in {**expected, "adaptive": expected.get("adaptive"), **exact}.items():
                 if isinstance(error, dict):  # the outcome differs between the models
                     error = error.get(model)
                 yield pytest.param(model, integrator, parameters, error, id=f"{case} | {model} | {integrator}")

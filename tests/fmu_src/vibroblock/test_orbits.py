@@ -50,3 +50,33 @@ def test_friction_is_lost_before_contact_and_by_sqrt2_at_kn_over_gamma():
     normal = [-(y * 1.0) - 0.07 * v for y, v in (steady_orbit(1.0, 1.0, 0.07, 1.0, a_n, omega, p)
                                                  for p in np.linspace(0, 2 * np.pi, 20001))]
     assert min(normal) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_an_undamped_contact_driven_at_its_resonance_has_no_steady_orbit_and_says_so():
+    """m y'' + k_n y = m A omega^2 sin(theta) at omega^2 = k_n / m grows without bound: the
+    formula refuses it, and a run asked to start on that orbit is refused with a message
+    that names the way out, instead of failing on a division by zero."""
+    import pytest
+
+    from vibroblock import Block, ModelError
+    from vibroblock.orbits import orbit_response
+
+    with pytest.raises(ValueError, match="resonance"):
+        orbit_response(1.0, 4.0, 0.0, 0.5, 2.0)
+    assert orbit_response(1.0, 4.0, 0.0, 0.0, 2.0) == 0.0  # no drive, no orbit to grow
+    assert abs(orbit_response(1.0, 4.0, 1e-9, 0.5, 2.0)) > 1e8  # damped: finite, huge
+    for model in "AC":
+        block = Block(model, "adaptive", initial_state=2, gamma_n=0.0, A=2.0, omega=1.0)
+        with pytest.raises(ModelError, match=r"no steady in-contact orbit.*initial_state = 0 or 1"):
+            block.start()
+    # event_driven's closed-form contact flow has the same denominator: refused up front.
+    block = Block("A", "event_driven", initial_state=0, gamma_n=0.0, A=2.0, omega=1.0)
+    with pytest.raises(ModelError, match=r"undamped contact .* resonance .* use adaptive"):
+        block.start()
+    # adaptive integrates it from rest: finite, and the energy balance closes.
+    block = Block("A", "adaptive", initial_state=0, gamma_n=0.0, A=2.0, omega=1.0, energy_balance=True)
+    block.start()
+    block.advance_to(1e3)
+    out = block.outputs()
+    assert all(np.isfinite(float(value)) for value in out.values()), out
+    assert abs(out["energy_residual"]) < 1e-4 * (out["energy_dissipated"] + abs(out["work_input"]))
