@@ -56,8 +56,6 @@ def test_an_undamped_contact_driven_at_its_resonance_has_no_steady_orbit_and_say
     """m y'' + k_n y = m A omega^2 sin(theta) at omega^2 = k_n / m grows without bound: the
     formula refuses it, and a run asked to start on that orbit is refused with a message
     that names the way out, instead of failing on a division by zero."""
-    import pytest
-
     from vibroblock import Block, ModelError
     from vibroblock.orbits import orbit_response
 
