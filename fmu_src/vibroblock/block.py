@@ -62,8 +62,18 @@ class Block:
     readings = property(lambda self: self.settings.readings)
 
     def set_parameter(self, name: str, value: float) -> None:
+        """Set a parameter; during a run only A and omega, which retune the drive.  A
+        retuned drive is checked with the rest of the settings (e.g. event_driven refuses
+        an undamped contact driven at its own resonance) and on refusal the previous value
+        is kept."""
+        previous = self.parameters.get(name)
         self.settings.set_parameter(name, value)
         if self.started:
+            try:
+                self.settings.check(self.frozen_released)
+            except ModelError:
+                self.parameters[name] = previous
+                raise
             self._retune_drive()
 
     def set_integrator(self, integrator: str | int) -> None:
@@ -113,9 +123,6 @@ class Block:
         record.step_budget = self._step_budget
         record.t0, record.dt = self._grid
         record.ready = int(entry is not None)
-
-    def check_stability(self) -> None:
-        self.settings.check(self.frozen_released)
 
     def _release_frozen_vertical(self) -> None:
         """The frozen_vertical guard hands over to the full model, which must run at this dt."""

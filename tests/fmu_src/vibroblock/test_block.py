@@ -123,6 +123,26 @@ def test_only_the_drive_is_tunable_during_a_run():
     assert block.parameters["A"] == 0.1
 
 
+def test_a_drive_retuned_during_a_run_is_checked_and_a_refused_value_leaves_the_run_as_it_was():
+    """event_driven refuses an undamped contact driven at its resonance omega = sqrt(k_n/m)
+    at start; retuning omega onto it during the run is refused the same way, with the
+    previous omega kept, and the run goes on exactly as one never asked to retune."""
+    def run(retune: bool):
+        block = Block("A", "event_driven", initial_state=0, gamma_n=0.0, A=2.0, omega=0.9)
+        block.start()
+        block.advance_to(10.0)
+        if retune:
+            with pytest.raises(ModelError, match=r"undamped contact .* resonance"):
+                block.set_parameter("omega", 1.0)
+            assert block.parameters["omega"] == 0.9
+        block.advance_to(40.0)
+        return block.outputs()
+
+    retuned = run(retune=True)
+    assert all(math.isfinite(float(value)) for value in retuned.values())
+    assert retuned == run(retune=False)
+
+
 def test_a_non_finite_state_is_reported_and_the_last_good_state_kept():
     block = Block("A", k_d=10.0, V_d=1e308)
     block.start()
