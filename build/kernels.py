@@ -51,7 +51,7 @@ from vibroblock.models import VARIANTS, offered_by
 from vibroblock.parameters import READINGS, SCENE_OPTIONS
 
 share, shares = map(int, sys.argv[1:3])
-# Relative compile costs (adaptive RODAS4 kernels take ~45 s of CPU each, a
+# Relative compile costs (adaptive kernels, RODAS4 and DOP853, take ~45 s of CPU each, a
 # fixed-step scheme a few seconds), so that the children finish together.
 COST = {"adaptive": 10, "event_driven": 6, "implicit_contact": 3}
 

@@ -245,7 +245,8 @@ _RECORDS = (
                     "(tangent_frame)" if r["formulation"] == 1 else
                     "follows the surface's frame in flight too (its flight segments are exact flows along the "
                     "frozen tangent), not flight = 1 (free)" if r["flight"] == 1 else None)),
-    Integrator(4, "adaptive", "error-controlled Rosenbrock (RODAS4) steps with located events, stiff-stable",
+    Integrator(4, "adaptive", "error-controlled steps with located events: explicit DOP853 where the motion is "
+               "not stiff, stiff-stable RODAS4 where it is",
                models="*", force_evaluations=0, check_step=_tolerances, advance=adaptive.advance,
                observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False),
     # adaptive runs every reading: the tangent frame through position_rates, the applied-load

@@ -14,7 +14,9 @@ from harness.paper.reference import Solver
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 VALLEY_X = (-0.5 * math.pi + 0.005) / 0.02  # slope 0.1 of the paper's corrugation, near a valley
-TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+# Tight enough for 1e-7 on every scenario: DOP853's error estimate lets the global error
+# of the B stick-slip run (590 located resets) grow to ~1e3 rtol (1.3e-7 at rtol 1e-10).
+TIGHT = {"rtol": 1e-11, "atol": 1e-13}
 # name -> (parameters, horizon, initial_state, x_start offset).  Short horizons: the
 # bouncing runs stay non-chaotic; the drive spring starts stretched by 40 so that the
 # embedded block slips (Coulomb resets) within the horizon.
@@ -63,8 +65,29 @@ def test_agrees_with_the_independent_reference(model, name):
     energy = out["work_input"] ** 2 + out["energy_dissipated"] ** 2
     assert abs(out["energy_residual"]) < 1e-8 * max(1.0, math.sqrt(energy))
     counters = block.counters
-    assert counters["accepted"] > 0 and counters["jacobians"] >= counters["accepted"]
+    assert counters["accepted"] > 0 and counters["jacobians"] >= 1  # the start's, which chooses the method
     assert counters["events"] >= counters["resets"]
+
+
+def test_the_explicit_pair_steps_motion_that_is_not_stiff_and_rodas4_motion_that_is():
+    """Contact and friction springs with k/m ~ 1, stepped at rtol 1e-8, are far inside the
+    explicit pair's stability bound: after the start's linearisation no step needs a
+    Jacobian.  A contact with k_n/m = 1e6 puts the first step beyond the bound: RODAS4
+    takes every step, each with its Jacobian.  Both agree with the reference."""
+    parameters, horizon, initial, x_start = scenario("C", "stick-slip")
+    ref = reference.simulate("C", parameters, horizon, solver=Solver.reference(1e-12), initial=initial,
+                             x_start=x_start)
+    block = run("C", parameters, horizon, initial, x_start, rtol=1e-8, atol=1e-10)
+    counters = block.counters
+    assert counters["jacobians"] == 1 and counters["accepted"] > 100
+    assert error(block.outputs(), ref) < 1e-6
+
+    stiff = dict(SCALED, k_n=1e6, gamma_n=2e2)
+    ref = reference.simulate("A", stiff, 50.0, solver=Solver.reference(1e-12), initial=0, x_start=-40.0)
+    block = run("A", stiff, 50.0, 0, -40.0, rtol=1e-8, atol=1e-10)
+    counters = block.counters
+    assert counters["jacobians"] >= counters["accepted"] > 0
+    assert error(block.outputs(), ref) < 1e-6
 
 
 @pytest.mark.parametrize("name", ["stick-slip", "sub-threshold", "bouncing"])
@@ -87,7 +110,7 @@ def test_error_falls_with_rtol(model):
     ref = reference.simulate(model, parameters, horizon, solver=Solver.reference(1e-12), initial=initial,
                              x_start=x_start)
     errors, costs = [], []
-    for rtol in (1e-5, 1e-7, 1e-9):
+    for rtol in (1e-6, 1e-8, 1e-10):  # B's resets let DOP853's global error reach ~1e2 rtol here
         block = run(model, parameters, horizon, initial, x_start, rtol=rtol, atol=rtol * 1e-2)
         errors.append(error(block.outputs(), ref))
         costs.append(block.counters["accepted"])
