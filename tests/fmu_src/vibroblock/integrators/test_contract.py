@@ -70,8 +70,10 @@ def test_rule_2_stored_state_obeys_the_friction_rule(record, model, keywords):
 
 @pytest.mark.parametrize("record, model, keywords", list(cases()))
 def test_rule_3_any_split_of_a_run_gives_the_same_result(record, model, keywords):
+    tight = {"rtol": 1e-10, "atol": 1e-12} if record.name == "adaptive" else {}
+
     def run(stops):
-        block = make(model, keywords, **VIBRATED)
+        block = make(model, keywords, **VIBRATED, **tight)
         block.start()
         for t in stops:
             block.advance_to(t)
@@ -83,8 +85,11 @@ def test_rule_3_any_split_of_a_run_gives_the_same_result(record, model, keywords
     if record.splits_bitwise:
         assert one == many and y_one.tobytes() == y_many.tobytes()
     else:
+        # Its steps depend on where a call stops, so two splits differ by the global error:
+        # for adaptive (rtol 1e-10 here) up to ~1e2 rtol across the run's landings and resets.
+        bound = 1e2 * tight.get("rtol", 1e-11)
         for name, value in one.items():
-            assert many[name] == pytest.approx(value, rel=1e-9, abs=1e-9), name
+            assert many[name] == pytest.approx(value, rel=bound, abs=bound), name
 
 
 @pytest.mark.parametrize("record, model, keywords", list(cases()))
