@@ -547,6 +547,12 @@ def _interpolate(explicit, v, out, k, kx, h, s, res):
 
 
 @njit(inline="always")
+def _control_exponent(explicit):
+    """The step control's exponent, -1 / (order of the error estimate + 1)."""
+    return -0.125 if explicit else -0.25
+
+
+@njit(inline="always")
 def _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, kx,
           stage, rate, out):
     """One step of the method in use; its weighted RMS error."""
@@ -640,7 +646,7 @@ def _period(kind, regime, v0, t_abs, shift, drv, cnt, n0, u, period, cap, h_firs
             tally[2] += 1
         err = _step(explicit, kind, regime, probe, t_abs + shift + local, drv, cnt, n0, u + local, h, prm,
                     track_energy, f0, jac, ft, lu, piv, k, kx, stage, rate, trial)
-        exponent = -0.125 if explicit else -0.25
+        exponent = _control_exponent(explicit)
         if record and not err <= 1.0:
             tally[1] += 1
             h *= SHRINK if not math.isfinite(err) else max(SHRINK, SAFETY * err ** exponent)
@@ -734,7 +740,8 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
     for i in range(NS):
         y0[i] = v[i]
     n_hs = _period(kind, regime, y0, t_base + u, 0.0, drv, cnt, n0, u, period, cap, h_first, prm, track_energy, hs,
-                   0, base, margins, scale, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx)
+                   0, base, margins, scale, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch,
+                   explicit, kx)
     if n_hs <= 0:
         return u
     rtol, atol, vd = prm[P_RTOL], prm[P_ATOL], prm[P_VD]
@@ -911,8 +918,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     best = np.zeros(NV)
     probe = np.zeros(NV)
     scratch = np.zeros((3, NV))
-    # The method in use (the explicit pair or RODAS4, see EXPLICIT_STIFF) and its switch.
-    explicit = next_explicit = False
+    # The switch between the explicit pair and RODAS4 (see EXPLICIT_STIFF).
     stiff = calm = 0
     hold = 0
 
@@ -1014,7 +1020,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         if not err <= 1.0:
             err = _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv,
                         k, kx, stage, rate, trial)
-        exponent = -0.125 if explicit else -0.25  # 1 / (order of the error estimate + 1)
+        exponent = _control_exponent(explicit)
         if not err <= 1.0:
             rejected += 1
             stagnant = 0
