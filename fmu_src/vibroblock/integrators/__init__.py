@@ -46,6 +46,7 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import typeof, types  # noqa: E402
 
 from . import adaptive, event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
+from ..orbits import orbit_response
 from .fixed_step import NON_FINITE, OK, STOP
 
 
@@ -97,8 +98,11 @@ def _no_limit(p: dict, model: str, name: str) -> str | None:
 def _undamped_resonance(p: dict, model: str, name: str) -> str | None:
     """event_driven's contact flow is the driven oscillator's closed form, whose particular
     solution divides by k_n - m omega^2 + i gamma_n omega: an undamped contact driven at its
-    own resonance has none (the secular solution grows like t), so it is refused up front."""
-    if p["gamma_n"] == 0.0 and p["A"] * p["omega"] != 0.0 and p["k_n"] == p["m"] * p["omega"] ** 2:
+    own resonance has none (the secular solution grows like t), so it is refused up front
+    (the condition is ``orbits.orbit_response``'s)."""
+    try:
+        orbit_response(p["m"], p["k_n"], p["gamma_n"], p["A"], p["omega"])
+    except ValueError:
         return (f"{name} cannot drive an undamped contact (gamma_n = 0) at its own resonance omega = sqrt(k_n / m) "
                 f"= {p['omega']:g}: its closed-form contact flow has no steady part there (the oscillation grows "
                 f"without bound); give gamma_n > 0, another omega, or use adaptive")
