@@ -49,3 +49,26 @@ def test_fig4_is_drawn_from_the_k_t_zero_trace(tmp_path):
     saved = []
     draw_fig4(study, lambda fig, name: (fig.savefig(tmp_path / name), saved.append(name)))
     assert saved == ["fig4_eq9_roots.png"] and (tmp_path / "fig4_eq9_roots.png").stat().st_size > 10_000
+
+
+def c5_measured(reference: dict, vibrated: dict) -> dict:
+    def run(a, **values):
+        return {"A": a, "peak_acceleration_over_g": a * 0.25, "regime": "stick_slip", "slip_events": 3,
+                "slip_interval": 1000.0, "slip_length": 50.0, "drift_velocity": 0.01, "contact_fraction": 1.0,
+                "slope_angle_end": 10.0, "max_x_difference": 0.0, "root_distance_median": 1.0, **values}
+    return {"runs": [run(0.0, **reference), run(5.0, **vibrated)], "wavelength": 314.0,
+            "frictionless": {"regime": "stick_slip", "slip_events": 2, "slip_length": 70.0,
+                             "root_distance_median": 1.0, "root_distance_p90": 2.0}}
+
+
+def test_c5a_compares_the_cycle_with_a_0_and_says_why_when_a_0_has_none():
+    from harness.paper.claims.c5_corrugated_plate import verdict_c5
+    from harness.paper.claims.verdicts import AGREES, DISAGREES, NOT_REPRODUCED
+
+    assert verdict_c5(c5_measured({}, {"slip_interval": 1050.0}))[0].verdict == AGREES
+    assert verdict_c5(c5_measured({}, {"slip_length": 70.0}))[0].verdict == DISAGREES
+    jammed = verdict_c5(c5_measured({"regime": "jammed", "slip_interval": None, "slope_angle_end": 82.7}, {}))[0]
+    assert jammed.verdict == NOT_REPRODUCED and "jams" in jammed.reason and "82.7" in jammed.reason
+    short = verdict_c5(c5_measured({"slip_interval": None, "slope_angle_end": 81.0}, {}))[0]
+    assert short.verdict == NOT_REPRODUCED and "fewer than two" in short.reason and "81" in short.reason
+    assert "A = 0 (A w^2/g = 0): jammed" in jammed.measured
