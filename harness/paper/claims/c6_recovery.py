@@ -32,8 +32,9 @@ from harness.runs.continuation import Ramp
 from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
 
-from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, c_run, ensemble_agrees, friction_held, observe_json,
-                      onset_amplitude, onset_omega, ramp_task, recovery, run_and_measure, start_ensemble)
+from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, SCALED_FIGURE_NOTE, c_run, ensemble_agrees,
+                      friction_held, observe_json, onset_amplitude, onset_omega, ramp_task, recovery, run_and_measure,
+                      start_ensemble)
 from .study import Claim, Runner, Study
 from .readings import DEFAULT_READING, READINGS
 from .verdicts import (AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, combine,
@@ -317,7 +318,9 @@ def draw(study: Study, save) -> None:
         points = [(r[key], r["A"]) for r in study.measured["diagram_rows"] if r.get(key) is not None]
         if points:
             ax.plot(*zip(*points), marker, color="k", mfc="none", ls="none", label=label)
-    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A", title="Model C")
+    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A",
+           title=f"Model C (the paper's Fig. 5)\n{SCALED_FIGURE_NOTE}")
+    ax.title.set_fontsize(8)
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
     ax.legend(fontsize="small")
     save(fig, "model_c_phase_diagram.png")
@@ -335,7 +338,9 @@ def draw(study: Study, save) -> None:
             ax.plot(missing, [ratio * 0.1] * len(missing), "x", color=f"C{number}")
         ax.axhline(ratio, color=f"C{number}", ls=":", lw=0.8)
     ax.set(xscale="log", yscale="log", xlabel="$k_n$", ylabel=r"$\omega_2$",
-           title="Friction recovery (x: none found; dotted: $k_n/\\gamma_n$)")
+           title="Friction recovery, the paper's Fig. 6 (x: none found; dotted: $k_n/\\gamma_n$)\n"
+           + SCALED_FIGURE_NOTE)
+    ax.title.set_fontsize(8)
     ax.legend(fontsize="small")
     save(fig, "omega2_vs_k_n.png")
 

@@ -143,3 +143,21 @@ def test_both_sides_of_each_located_transition_are_rerun_from_four_starts_over_l
     else:
         assert verdicts["C6b"].verdict == NOT_REPRODUCED and verdicts["C6c"].verdict == NOT_REPRODUCED
         assert "valley sliding" in verdicts["C6b"].reason
+
+
+def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from harness.paper.claims.study import Study
+
+    omegas, amplitudes = [0.5, 5.0, 50.0], [0.3, 3.0]
+    study = Study("C6", {"k_n_over_gamma_n": 14.3, "diagram_rows": [row(0.3, 5.0, 50.0, 5.2, 40.0)]}, {},
+                  {"omega": omegas, "A": amplitudes, "regime": [["stick_slip", "sliding", "stick_slip"]] * 2,
+                   "recovery_vs_k": [{"ratio": 14.3, "k_n": 1.0, "omega_2": 12.0},
+                                     {"ratio": 14.3, "k_n": 2.0, "omega_2": None}]})
+    titles = {}
+    c6_recovery.draw(study, lambda figure, name: titles.setdefault(name, figure.axes[0].get_title()))
+    assert set(titles) == {"model_c_phase_diagram.png", "omega2_vs_k_n.png"}
+    assert "Fig. 5" in titles["model_c_phase_diagram.png"] and "Fig. 6" in titles["omega2_vs_k_n.png"]
+    assert all("scaled drive" in title and "out of reach" in title for title in titles.values())

@@ -39,3 +39,19 @@ def test_a_flying_block_is_not_sliding():
     assert flying.verdict == NOT_REPRODUCED and "w = 3 (flying)" in flying.reason
     held, _ = verdict_c8(values(["stick_slip", "flying"], ["flying", "flying"]))
     assert held.verdict == DISAGREES
+
+
+def test_the_figure_for_the_papers_fig_7_says_which_drive_and_amplitude_it_runs():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from harness.paper.claims import c8_drive_velocity
+    from harness.paper.claims.study import Study
+
+    grid = [["sliding", "stick_slip"], ["sliding", "sliding"]]
+    study = Study("C8", {"model_a_amplitude": 2.0, "model_c_amplitude": 0.5}, {},
+                  {"omega": [0.1, 1.0], "V_d": [0.01, 10.0], "regime_c": grid, "regime_a": grid})
+    titles = {}
+    c8_drive_velocity.draw(study, lambda figure, name: titles.setdefault(name, figure.axes[0].get_title()))
+    assert "Fig. 7" in titles["model_c_Vd_omega.png"] and "A = 0.5" in titles["model_c_Vd_omega.png"]
+    assert "scaled" in titles["model_c_Vd_omega.png"] and "2e4" in titles["model_c_Vd_omega.png"]
