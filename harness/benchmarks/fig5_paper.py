@@ -41,11 +41,12 @@ the sliding cost, each interpolated log-log in omega between the measured points
 is divided by the workers.  The verdict compares that with 10 minutes.
 
 No diagram is drawn and no flag offers one: measured on the 2-core development machine
-(README, "Choosing speed or accuracy"), with adaptive's stroboscopic jumps across the
-held block's plate periods, the 8 x 8 diagram extrapolates to 1.9 h on 2 cores at
-``--rtol 1e-6`` and 1.2 days at the default 1e-8 in the tangent frame, 1.4 and 8.8 days in
-fixed axes (where the held orbit is not periodic and the jumps are refused).  Measured
-figures only; nothing here is a timed test.
+(README, "Choosing speed or accuracy"), with adaptive's explicit pair and its stroboscopic
+jumps across the held block's plate periods, the 8 x 8 diagram extrapolates to 43 min on
+2 cores at ``--rtol 1e-6`` and 6.9 h at the default 1e-8 in the tangent frame, 5.0 h and
+1.05 days in fixed axes (where the held orbit is not periodic and the jumps are refused).
+A held block's jumps shrink along a stick (README), so a cap that covers only the start
+of a stick extrapolates low.  Measured figures only; nothing here is a timed test.
 """
 from __future__ import annotations
 
