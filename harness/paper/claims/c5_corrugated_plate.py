@@ -101,9 +101,9 @@ def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
     reference = runs[0]
     if reference.get("regime") == "jammed":
         # On the paper's corrugation (slopes up to arctan(A_x omega_x) = 87 deg) the drive
-        # pushes the unvibrated block up a flank steeper than arctan(1/mu_s), where the
-        # pull presses it into the surface as much as it drags it: there is no stick-slip
-        # cycle at A = 0 to compare with, however long the window.
+        # pushes the unvibrated block up a flank steeper than arctan(1/mu_s), where mu_s
+        # times the pull's share normal to the surface exceeds its share along it: there is
+        # no stick-slip cycle at A = 0 to compare with, however long the window.
         row_a = Row("C5a", measured_a, NOT_REPRODUCED,
                     f"no stick-slip cycle at A = 0: the block jams (self-locked on a flank at alpha = "
                     f"{fmt(reference.get('slope_angle_end'))} deg, steeper than arctan(1/mu_s)), so there is no "
