@@ -43,14 +43,19 @@ def regime_scatter(ax, xs, ys, regimes):
             ax.scatter(xs[chosen], ys[chosen], marker=style["marker"], color=style["color"], label=style["label"])
 
 
-def regime_grid(ax, omegas, amplitudes, regimes, onset, load_label: str, onset_label: str) -> None:
+def regime_grid(ax, omegas, amplitudes, regimes, onset, load_label: str, onset_label: str, loss=None,
+                loss_label: str = r"$A_N(\omega)$: $N$ reaches 0") -> None:
     """Regimes on an omega x A grid (``regimes[i][j]`` at amplitudes[i], omegas[j]) with the
-    lines A = load/(m omega^2) (load = m = 1 in the studies' units) and ``onset(omega)``."""
+    lines A = load/(m omega^2) (load = m = 1 in the studies' units), ``onset(omega)`` (the
+    detachment onset A_c) and, if given, ``loss(omega)`` (the friction-loss onset A_N, where
+    the contact force and with it the Coulomb bound first vanish, the block still embedded)."""
     omega, amplitude = np.meshgrid(omegas, amplitudes)
     regime_scatter(ax, omega.ravel(), amplitude.ravel(), np.asarray(regimes).ravel())
     line = np.geomspace(min(omegas), max(omegas), 300)
     ax.plot(line, 1 / line**2, "k:", label=load_label)
     ax.plot(line, onset(line), "k-", lw=1, label=onset_label)
+    if loss is not None:
+        ax.plot(line, loss(line), "--", color="tab:red", lw=1, label=loss_label)
 
 
 def plot_trajectories(runs: Mapping[str, xr.Dataset], ax=None, drive: bool = True):

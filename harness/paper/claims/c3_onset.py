@@ -16,7 +16,7 @@ from harness.runs.bisection import Transition, refine
 from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
 
-from .measure import (OBSERVE_A, SCALED, friction_held, observe_json, onset_amplitude, regime_changes,
+from .measure import (OBSERVE_A, SCALED, friction_held, loss_amplitude, observe_json, onset_amplitude, regime_changes,
                       run_and_measure, transition_bracket)
 from .study import Claim, Runner, Study
 from .verdicts import AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, Row, combine, fmt
@@ -123,7 +123,8 @@ def draw(study: Study, save) -> None:
 
     d = study.data
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$")
+    regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$",
+                loss=loss_amplitude)
     located = [(c["omega"], c["located_A"]) for c in study.measured["columns"] if c.get("located_A") is not None]
     if located:
         ax.plot(*zip(*located), "D", color="k", mfc="none", label="boundary (bisected)")

@@ -33,8 +33,8 @@ from harness.runs.settings import PointSettings
 from harness.runs.sweep import Axis, Grid
 
 from .measure import (C_PARAMETERS, C_START, OBSERVE_SHORT, SCALED_FIGURE_NOTE, c_run, ensemble_agrees,
-                      friction_held, observe_json, onset_amplitude, onset_omega, ramp_task, recovery, run_and_measure,
-                      start_ensemble)
+                      friction_held, loss_amplitude, observe_json, onset_amplitude, onset_omega, ramp_task, recovery,
+                      run_and_measure, start_ensemble)
 from .study import Claim, Runner, Study
 from .readings import DEFAULT_READING, READINGS
 from .verdicts import (AGREES, DISAGREES, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row, combine,
@@ -311,7 +311,7 @@ def draw(study: Study, save) -> None:
     d = study.data
     fig, ax = plt.subplots(figsize=(6, 4.5))
     regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = P_l/(m\omega^2)$",
-                r"$A_c(\omega)$ with $P_l$")
+                r"$A_c(\omega)$ with $P_l$", loss=loss_amplitude, loss_label=r"$A_N(\omega)$ with $P_l$")
     ax.axvline(study.measured["k_n_over_gamma_n"], color="tab:green", ls="--", label=r"$k_n/\gamma_n$")
     for key, marker, label in (("located_omega_1", "D", r"friction lost (bisected)"),
                                ("located_omega_2", "^", r"friction back (bisected)")):

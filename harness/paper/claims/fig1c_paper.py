@@ -16,7 +16,7 @@ import numpy as np
 
 from harness.runs.settings import ObservableSettings, PointSettings
 
-from .measure import friction_held, observe_json, onset_amplitude, run_and_measure
+from .measure import friction_held, loss_amplitude, observe_json, onset_amplitude, run_and_measure
 from .study import Claim, Runner, Study
 from .verdicts import fmt
 
@@ -106,7 +106,8 @@ def draw(study: Study, save) -> None:
     if not d.get("omega"):
         return
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$")
+    regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$",
+                loss=loss_amplitude)
     ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A",
            title=f"Model A, the paper's parameters (>= {study.settings['cycles']} stick-slip cycles per point)")
     ax.title.set_fontsize(9)

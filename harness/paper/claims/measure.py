@@ -185,6 +185,13 @@ def onset_amplitude(omega, load: float = 1.0, m: float = 1.0, k_n: float = 1.0, 
     return detachment_amplitude(omega, m=m, g=load / m, k_n=k_n, gamma_n=gamma_n)
 
 
+def loss_amplitude(omega, load: float = 1.0, m: float = 1.0, k_n: float = 1.0, gamma_n: float = 0.07):
+    """A_N(omega), the friction-loss onset of the same orbit: its contact force first reaches
+    0 (``vibroblock.orbits.friction_loss_amplitude`` with g = load / m)."""
+    from vibroblock.orbits import friction_loss_amplitude
+    return friction_loss_amplitude(omega, m=m, g=load / m, k_n=k_n, gamma_n=gamma_n)
+
+
 def observe_json(observe_settings: ObservableSettings) -> dict:
     return {"phi_threshold": observe_settings.phi_threshold, "transient": observe_settings.transient,
             "window": "rest of run" if observe_settings.window is None else observe_settings.window,

@@ -145,7 +145,7 @@ def test_both_sides_of_each_located_transition_are_rerun_from_four_starts_over_l
         assert "valley sliding" in verdicts["C6b"].reason
 
 
-def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive():
+def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive_and_draw_both_onsets():
     import matplotlib
 
     matplotlib.use("Agg")
@@ -156,8 +156,16 @@ def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive()
                   {"omega": omegas, "A": amplitudes, "regime": [["stick_slip", "sliding", "stick_slip"]] * 2,
                    "recovery_vs_k": [{"ratio": 14.3, "k_n": 1.0, "omega_2": 12.0},
                                      {"ratio": 14.3, "k_n": 2.0, "omega_2": None}]})
-    titles = {}
-    c6_recovery.draw(study, lambda figure, name: titles.setdefault(name, figure.axes[0].get_title()))
+    titles, legends = {}, {}
+
+    def save(figure, name):
+        titles[name] = figure.axes[0].get_title()
+        legends[name] = figure.axes[0].get_legend_handles_labels()[1]
+
+    c6_recovery.draw(study, save)
     assert set(titles) == {"model_c_phase_diagram.png", "omega2_vs_k_n.png"}
+    # Both onsets on the diagram: detachment A_c and friction loss A_N.
+    diagram = legends["model_c_phase_diagram.png"]
+    assert any("A_c" in label for label in diagram) and any("A_N" in label for label in diagram)
     assert "Fig. 5" in titles["model_c_phase_diagram.png"] and "Fig. 6" in titles["omega2_vs_k_n.png"]
     assert all("scaled drive" in title and "out of reach" in title for title in titles.values())
