@@ -122,7 +122,7 @@ def draw(study: Study, save) -> None:
     import matplotlib.pyplot as plt
 
     d = study.data
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(8.5, 4.5))
     regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$",
                 loss=loss_amplitude)
     located = [(c["omega"], c["located_A"]) for c in study.measured["columns"] if c.get("located_A") is not None]
@@ -130,7 +130,7 @@ def draw(study: Study, save) -> None:
         ax.plot(*zip(*located), "D", color="k", mfc="none", label="boundary (bisected)")
     ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A", title="Model A (scaled drive)")
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
-    ax.legend(fontsize="small")
+    ax.legend(fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.5))  # beside the grid, not over it
     save(fig, "fig1c_phase_diagram_A.png")
 
 

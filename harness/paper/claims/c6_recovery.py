@@ -309,7 +309,7 @@ def draw(study: Study, save) -> None:
     import matplotlib.pyplot as plt
 
     d = study.data
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(8.5, 4.5))
     regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = P_l/(m\omega^2)$",
                 r"$A_c(\omega)$ with $P_l$", loss=loss_amplitude, loss_label=r"$A_N(\omega)$ with $P_l$")
     ax.axvline(study.measured["k_n_over_gamma_n"], color="tab:green", ls="--", label=r"$k_n/\gamma_n$")
@@ -322,7 +322,7 @@ def draw(study: Study, save) -> None:
            title=f"Model C (the paper's Fig. 5)\n{SCALED_FIGURE_NOTE}")
     ax.title.set_fontsize(8)
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
-    ax.legend(fontsize="small")
+    ax.legend(fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.5))  # beside the grid, not over it
     save(fig, "model_c_phase_diagram.png")
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
