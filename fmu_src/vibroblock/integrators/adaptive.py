@@ -194,6 +194,7 @@ EXPLICIT_E3 = np.ascontiguousarray(_DOP853.E3)
 # h ||J||_inf < EXPLICIT_CALM, and at least STIFF_HOLD steps after the last hand-over.
 EXPLICIT_STIFF = 6.1
 STIFF_AFTER = 15
+STIFF_FORGET = 6  # non-stiff steps in a row that clear the count of stiff ones (as DOP853)
 EXPLICIT_CALM = 1.0
 STIFF_HOLD = 32
 
@@ -1043,7 +1044,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                     next_explicit, stiff, hold = False, 0, STIFF_HOLD
             else:
                 calm += 1
-                if calm >= 6:
+                if calm >= STIFF_FORGET:
                     stiff = 0
         else:
             hold = max(hold - 1, 0)
