@@ -479,7 +479,9 @@ int python_runtime_ready(const char* fmu_root, char* error, size_t size)
 
 /* The record a Block keeps for a front end (vibroblock/native.py, NativeStep: the same
  * fields in the same order; LAYOUT there is NATIVE_LAYOUT here). */
-#define NATIVE_LAYOUT 1
+#define NATIVE_LAYOUT 2
+#define OUTPUT_SURFACE_Z (-1) /* native.SURFACE_Z: z + penetration / cos(alpha) */
+#define OUTPUT_ZERO (-2)      /* native.ZERO */
 typedef struct {
     int64_t layout;
     int64_t ready;    /* a run has started and its advance kernel is bound */
@@ -498,7 +500,16 @@ typedef struct {
     double t0, dt;
     double time;
     double grid_tolerance, time_tolerance;
+    int64_t (*observe)(int64_t flags, double* y, int64_t* cnt, double* drv, double* prm, double h,
+                       int64_t track_energy, double* obs);
+    int64_t observed_ok;     /* what observe returns when it filled obs */
+    double* obs;
+    const int64_t* outputs;  /* n_outputs pairs (value reference, observation slot or OUTPUT_*) */
+    int64_t n_outputs;
 } NativeStep;
+
+/* Observation slots the computed outputs use (vibroblock/layout.py). */
+enum { O_Z = 1, O_PENETRATION = 5, O_COS = 7, N_OBS = 16 };
 
 /* The slave's record (its attribute native_step, the address), or NULL. */
 static void* claim_native_step(PyObj slave)
@@ -534,6 +545,41 @@ int python_slave_native_step(const PythonSlave* slave, double t, double h)
             != n->returned_ok)
         return 0;
     n->time = end;
+    return 1;
+}
+
+/* The slave's Block outputs for a read whose value references are all in the record's
+ * table: Block._observe's time within the grid step, one call of the observe kernel, and
+ * Block._observables' arithmetic, so the same bits.  0 (values undefined) when the read
+ * must go to the slave: a reference not in the table, no run started, a kernel that
+ * raised, or a value that is not finite (the slave's read is then the one on record). */
+int python_slave_native_get_real(const PythonSlave* slave, const unsigned int vr[], size_t nvr, double values[])
+{
+    NativeStep* n = (NativeStep*)slave->native;
+    if (n == NULL || !n->ready || n->observe == NULL || n->obs == NULL || n->outputs == NULL) return 0;
+    int64_t source[64];
+    if (nvr > sizeof source / sizeof source[0]) return 0;
+    for (size_t i = 0; i < nvr; i++) {
+        int64_t k = 0;
+        while (k < n->n_outputs && n->outputs[2 * k] != (int64_t)vr[i]) k++;
+        if (k == n->n_outputs) return 0;
+        source[i] = n->outputs[2 * k + 1];
+        if (source[i] >= N_OBS || source[i] < OUTPUT_ZERO) return 0;
+    }
+    double grid_time = n->t0 + (double)n->cnt[n->step_slot] * n->dt;
+    double h = n->time - grid_time;
+    if (h < n->grid_tolerance * n->dt) h = 0.0;  /* on the grid up to rounding of the master's time */
+    if (n->observe(n->flags, n->y, n->cnt, n->drv, n->prm, fmin(h, n->dt), n->track_energy, n->obs) !=
+        n->observed_ok)
+        return 0;
+    const double* obs = n->obs;
+    for (size_t i = 0; i < nvr; i++) {
+        double value = source[i] >= 0               ? obs[source[i]]
+                       : source[i] == OUTPUT_ZERO    ? 0.0
+                                                     : obs[O_Z] + obs[O_PENETRATION] / obs[O_COS];
+        if (!isfinite(value)) return 0;
+        values[i] = value;
+    }
     return 1;
 }
 

@@ -14,7 +14,7 @@ import numpy as np
 from . import interface
 from . import layout as L
 from .initial_state import frame_to_point, place
-from .native import LAYOUT, RETURNED_OK, NativeStep, entry_address
+from .native import LAYOUT, OBSERVED_OK, RETURNED_OK, SURFACE_Z, ZERO, NativeStep, entry_address
 from .settings import ModelError, Settings
 
 OUTPUTS = tuple(interface.OUTPUTS)
@@ -25,6 +25,13 @@ GRID_TOLERANCE = 1e-6
 # request beyond it (e.g. a horizon of 1e9 at dt = 4e-4: 2.5e12 steps, hours) is refused
 # with its cost and the ways around it instead of holding the host.
 STEP_BUDGET_PER_CALL = 2**36
+# The Real outputs that are plain entries of the observation in every reading: a native
+# front end may read them without Python (vibroblock.native; _observables is the reference).
+OBSERVED_OUTPUTS = {"x": L.O_X, "friction_force": L.O_FRICTION, "normal_force": L.O_NORMAL,
+                    "phi_integral": L.O_PHI, "penetration": L.O_PENETRATION, "work_input": L.O_WORK,
+                    "energy_dissipated": L.O_DISSIPATED}
+# ... and in the model's own reading, where the state is the point itself.
+OBSERVED_POINT = {"z": L.O_Z, "vx": L.O_VX, "vz": L.O_VZ, "surface_z": SURFACE_Z}
 
 __all__ = ["Block", "ModelError", "OUTPUTS"]
 
@@ -48,9 +55,11 @@ class Block:
         self._observed = None
         self._observed_time = math.nan
         # The run's time, and what a native front end needs to advance it (vibroblock.native).
-        self._native = NativeStep(layout=LAYOUT, returned_ok=RETURNED_OK, step_slot=L.C_STEP,
-                                  grid_tolerance=GRID_TOLERANCE, time=math.nan)
+        self._native = NativeStep(layout=LAYOUT, returned_ok=RETURNED_OK, observed_ok=OBSERVED_OK,
+                                  step_slot=L.C_STEP, grid_tolerance=GRID_TOLERANCE, time=math.nan)
         self._natively_driven = False
+        self._output_refs: dict[str, int] = {}
+        self._native_outputs = np.zeros((0, 2), dtype=np.int64)
 
     # ------------------------------------------------------------------ settings
     model = property(lambda self: self.settings.model)
@@ -95,13 +104,15 @@ class Block:
     time = property(lambda self: self._native.time, lambda self, t: setattr(self._native, "time", t),
                     doc="The run's time (kept in the NativeStep record, which a native front end advances).")
 
-    def drive_natively(self, record: NativeStep, time_tolerance: float) -> None:
+    def drive_natively(self, record: NativeStep, time_tolerance: float, output_refs: dict | None = None) -> None:
         """Let a native front end advance this block through ``record`` (its time moves
         there), with ``time_tolerance`` the front end's match of a master's time to the
         block's.  The record takes over this block's time and arrays; a record already
-        driving another block is simply re-pointed at this one."""
+        driving another block is simply re-pointed at this one.  ``output_refs`` (output
+        name -> value reference) lets the front end read those Real outputs too."""
         record.time, record.time_tolerance = self.time, time_tolerance
-        for name in ("layout", "returned_ok", "step_slot", "grid_tolerance"):
+        self._output_refs = dict(output_refs or {})
+        for name in ("layout", "returned_ok", "observed_ok", "step_slot", "grid_tolerance"):
             setattr(record, name, getattr(self._native, name))
         self._native, self._natively_driven = record, True
         record.ready = 0
@@ -122,7 +133,22 @@ class Block:
         record.track_energy = int(self._track_energy)
         record.step_budget = self._step_budget
         record.t0, record.dt = self._grid
+        record.observe = entry_address(kernel.observe, settings.kind, kernel.id)
+        record.obs = self.obs.ctypes.data
+        self._native_outputs = self._observed_outputs()
+        record.outputs, record.n_outputs = self._native_outputs.ctypes.data, len(self._native_outputs)
         record.ready = int(entry is not None)
+
+    def _observed_outputs(self) -> np.ndarray:
+        """(value reference, observation slot or SURFACE_Z / ZERO) of each output a front
+        end may read straight from the observation in this run."""
+        sources = dict(OBSERVED_OUTPUTS)
+        if self.settings.kind == self.settings.variant.kind:  # else z, vx, vz come from _as_point
+            sources.update(OBSERVED_POINT)
+        if not self.energy_balance:
+            sources["energy_residual"] = ZERO
+        pairs = [(self._output_refs[name], source) for name, source in sources.items() if name in self._output_refs]
+        return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
     def _release_frozen_vertical(self) -> None:
         """The frozen_vertical guard hands over to the full model, which must run at this dt."""

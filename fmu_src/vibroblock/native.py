@@ -1,4 +1,4 @@
-"""A doStep that does not enter Python: the advance kernels as C functions.
+"""A doStep and output reads that do not enter Python: the kernels as C functions.
 
 Through pythonfmu every doStep is a Python call (GIL, frames, the numba entry point
 unboxing four arrays): about 1.3 us, a tenth of a doStep of a thousand internal steps
@@ -14,6 +14,15 @@ the Python slave: the front end then calls the slave's do_step, which finds the 
 as the failed kernel call left it (contract rule 4 of ``vibroblock.integrators``) and
 says what went wrong.
 
+Reading outputs after each doStep is the other call a master makes all the time; through
+pythonfmu a read of five outputs is a Python call that builds the whole observation
+(about 7 us).  The record therefore also carries the observe kernel as a cfunc, the
+Block's observation array and a table of the Real outputs that are plain entries of
+that observation: (value reference, observation slot) pairs, or one of the two outputs
+computed from it (``SURFACE_Z``, ``ZERO``).  A front end asked for outputs that are all
+in the table fills them from one observe call, with the same arithmetic as
+``Block._observables``; any other read goes to the slave.
+
 The record is laid out as ``NativeStep`` in ``build/python_runtime.c``; ``LAYOUT``
 names the version both sides check.
 """
@@ -26,18 +35,27 @@ from numba import carray, cfunc, types  # noqa: E402
 
 from . import layout as L  # noqa: E402
 from .integrators import adaptive, event_driven, fixed_step  # noqa: E402
+from . import scenes  # noqa: E402  (after the integrators, which register its scheme)
 
-LAYOUT = 1  # bump with any change of NativeStep's fields
+LAYOUT = 2  # bump with any change of NativeStep's fields
+
+# Sources of a native output other than an observation slot (``layout.O_*``): the plate
+# surface under the block, z + penetration / cos(alpha); and an output that is 0 in this
+# run (energy_residual without the energy balance).
+SURFACE_Z, ZERO = -1, -2
 
 # A cfunc whose kernel raised returns 0 (numba zero-fills the result, prints the
 # exception and carries on), so the kernel's status is returned shifted: 0 is never a
 # status the kernel gave.
 STATUS_SHIFT = 1 << 20
 RETURNED_OK = STATUS_SHIFT + fixed_step.OK
+OBSERVED_OK = STATUS_SHIFT  # what an observe entry returns (a kernel that raised: 0)
 
 _F64, _I64 = types.CPointer(types.float64), types.CPointer(types.int64)
 # (flags, y, cnt, drv, prm, n_steps, track_energy) -> status + STATUS_SHIFT
 SIGNATURE = types.int64(types.int64, _F64, _I64, _F64, _F64, types.int64, types.int64)
+# (flags, y, cnt, drv, prm, h, track_energy, obs) -> STATUS_SHIFT when obs is filled
+OBSERVE_SIGNATURE = types.int64(types.int64, _F64, _I64, _F64, _F64, types.float64, types.int64, _F64)
 
 
 class NativeStep(ctypes.Structure):
@@ -63,6 +81,11 @@ class NativeStep(ctypes.Structure):
         ("time", ctypes.c_double),  # the Block's time: read and written by both sides
         ("grid_tolerance", ctypes.c_double),  # Block.advance_to's rounding to the grid
         ("time_tolerance", ctypes.c_double),  # the slave's match of a master's time to its own
+        ("observe", ctypes.c_void_p),  # OBSERVE_SIGNATURE, or NULL: every read goes to the slave
+        ("observed_ok", ctypes.c_int64),  # what observe returns when it filled obs
+        ("obs", ctypes.c_void_p),  # the Block's observation array (layout.N_OBS)
+        ("outputs", ctypes.c_void_p),  # int64 pairs (value reference, slot or SURFACE_Z / ZERO)
+        ("n_outputs", ctypes.c_int64),
     ]
 
 
@@ -97,14 +120,52 @@ def _adaptive_entry(kind: int, method: int):
     return advance
 
 
+def _fixed_step_observe(kind: int, method: int):
+    @cfunc(OBSERVE_SIGNATURE, cache=True)
+    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+        fixed_step.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
+                           carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
+        return OBSERVED_OK
+    return observe
+
+
+def _event_driven_observe(kind: int, method: int):
+    @cfunc(OBSERVE_SIGNATURE, cache=True)
+    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+        event_driven.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
+                             carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
+        return OBSERVED_OK
+    return observe
+
+
+def _adaptive_observe(kind: int, method: int):
+    @cfunc(OBSERVE_SIGNATURE, cache=True)
+    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+        adaptive.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
+                         carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
+        return OBSERVED_OK
+    return observe
+
+
+def _scene_observe(kind: int, method: int):
+    @cfunc(OBSERVE_SIGNATURE, cache=True)
+    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+        scenes.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
+                       carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
+        return OBSERVED_OK
+    return observe
+
+
 _FACTORIES = {fixed_step.advance: _fixed_step_entry, event_driven.advance: _event_driven_entry,
-              adaptive.advance: _adaptive_entry}
+              adaptive.advance: _adaptive_entry, fixed_step.observe: _fixed_step_observe,
+              event_driven.observe: _event_driven_observe, adaptive.observe: _adaptive_observe,
+              scenes.observe: _scene_observe}
 _ENTRIES: dict = {}  # (kernel, kind, method) -> cfunc, kept alive with its code
 
 
 def entry_address(kernel, kind: int, method: int) -> int | None:
-    """The C address of ``kernel`` for (kind, method), compiled or loaded from the cache
-    once per process; None for a kernel without a C entry."""
+    """The C address of ``kernel`` (an advance or observe kernel) for (kind, method),
+    compiled or loaded from the cache once per process; None for a kernel without a C entry."""
     key = (kernel, kind, method)
     if key not in _ENTRIES:
         factory = _FACTORIES.get(kernel)

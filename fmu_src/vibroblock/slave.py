@@ -42,11 +42,13 @@ class BlockFacade(FmuFacade):
         self._native_step = NativeStep()
         self.native_step = ctypes.addressof(self._native_step)
         self.block = Block(self.model)
-        self.block.drive_natively(self._native_step, TIME_TOLERANCE)
         self.plate_input = {name: 0.0 for name in INPUTS}
         self._input_changed = False
         self._healthy = self._check_core(kwargs.get("resources"))
         self._register_interface()
+        # Output name -> value reference: what the front end may also read without Python.
+        self._output_refs = {var.name: vr for vr, var in self.vars.items() if var.name in OUTPUTS}
+        self.block.drive_natively(self._native_step, TIME_TOLERANCE, self._output_refs)
 
     # ------------------------------------------------------------------ interface
     def _register_interface(self) -> None:
@@ -188,7 +190,7 @@ class BlockFacade(FmuFacade):
             raise ModelError(f"not a valid FMU state for {self.model}: {exc!r}") from None
         self.start_time = float(state["start_time"])
         self.plate_input = plate_input
-        block.drive_natively(self._native_step, TIME_TOLERANCE)
+        block.drive_natively(self._native_step, TIME_TOLERANCE, self._output_refs)
         self.block = block
         self._input_changed = bool(state["input_changed"])
 

@@ -15,9 +15,10 @@ Prints side by side:
 2. at 1000 internal steps per doStep: time per doStep through the C master and fmpy
    against the bare core doing the same work, and time per output read after each step
    (5 outputs read in one call), with the FMU's native front end running each doStep
-   without Python (as shipped: the compiled kernel called through the Block's
-   NativeStep record, vibroblock/native.py) and, for comparison, with every doStep a
-   Python call through pythonfmu's library (``VIBROBLOCK_PYTHONFMU_DOSTEP=1``), and
+   and each read without Python (as shipped: the compiled advance and observe kernels
+   called through the Block's NativeStep record, vibroblock/native.py) and, for
+   comparison, with every doStep and read a Python call through pythonfmu's library
+   (``VIBROBLOCK_PYTHONFMU_DOSTEP=1``), and
    fmpy's own cost of an FMI call (timed on one that does not enter Python).  Each
    figure is given as the mean over all doSteps and
    as the mean of the quietest block of BLOCK doSteps: on a shared machine the load of
@@ -245,9 +246,9 @@ def main(argv=None):
         cache = work / "cache-host-cold"
         rows = [("C master -> FMU", host_per_call(host, folder, md, vr, args.calls, child_env(cache))),
                 ("fmpy -> FMU", fmpy_per_call(folder, md, args.calls)),
-                ("C master -> FMU, doStep via pythonfmu",
+                ("C master -> FMU, all via pythonfmu",
                  host_per_call(host, folder, md, vr, args.calls, child_env(cache, through_pythonfmu=True))),
-                ("fmpy -> FMU, doStep via pythonfmu", fmpy_per_call(folder, md, args.calls, through_pythonfmu=True))]
+                ("fmpy -> FMU, all via pythonfmu", fmpy_per_call(folder, md, args.calls, through_pythonfmu=True))]
         layer = fmpy_call_layer(folder, md, args.calls)
         bare, chunked = bare_core_per_call(args.calls)
 

@@ -253,19 +253,25 @@ NATIVE_CASES = [
 
 def scripted_run(extracted, log, model, settings):
     """60 doSteps of 0.5 with a plate input set before every tenth, a refused doStep, and
-    an FMU state restored: (outputs after each step, time of each doStep Python ran)."""
+    an FMU state restored: (outputs after each step, time of each doStep Python ran,
+    names of the outputs Python read)."""
     from vibroblock import slave as slave_module
 
-    python_steps = []
-    original = slave_module.BlockFacade.do_step
+    python_steps, python_reads = [], []
+    original, original_output = slave_module.BlockFacade.do_step, slave_module.BlockFacade._output
 
     def counted(self, t, h):
         python_steps.append(t)
         return original(self, t, h)
 
+    def counted_output(self, name):
+        python_reads.append(name)
+        return original_output(self, name)
+
     rows = []
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(slave_module.BlockFacade, "do_step", counted)
+        patch.setattr(slave_module.BlockFacade, "_output", counted_output)
         with instance(extracted, model, log, settings) as (slave, vr):
             t = 0.0
             for k in range(60):
@@ -284,7 +290,7 @@ def scripted_run(extracted, log, model, settings):
                 assert do_step(slave, t, 0.5) == fmi2OK
                 rows.append(reals(slave, vr))
             slave.freeFMUstate(saved)
-    return np.array(rows), python_steps
+    return np.array(rows), python_steps, python_reads
 
 
 @pytest.mark.parametrize("model, settings", NATIVE_CASES)
@@ -293,12 +299,16 @@ def test_plain_do_steps_run_without_python_and_give_the_same_bits(extracted, fmu
     """The front end runs a plain doStep through the Block's NativeStep record
     (vibroblock/native.py), with no Python call; a doStep after a new input, a refused
     one and the one where frozen_vertical's guard hands over go to the slave's do_step.
-    Left to pythonfmu (every doStep a Python call) the run has the same bits."""
-    native, python_steps = scripted_run(extracted, fmu_log, model, settings)
+    The outputs read after each step come from the record's observation without Python;
+    in a reading other than the model's own (B here: the tangent frame) Python converts
+    the block's height and velocities and the surface under it, so a read that asks for
+    any of them goes to Python whole.  Left to pythonfmu (every doStep and read a Python call) the run has the same bits."""
+    native, python_steps, python_reads = scripted_run(extracted, fmu_log, model, settings)
     monkeypatch.setenv("VIBROBLOCK_PYTHONFMU_DOSTEP", "1")
-    through_python, every_step = scripted_run(extracted, fmu_log, model, settings)
+    through_python, every_step, every_read = scripted_run(extracted, fmu_log, model, settings)
     assert native.tobytes() == through_python.tobytes()
-    assert len(every_step) == 71
+    assert len(every_step) == 71 and len(every_read) == 70 * len(OUTPUTS)
+    assert python_reads == (every_read if settings.get("formulation") else [])
     inputs = [0.5 * k for k in range(5, 60, 10)]
     refused = 18.0
     handover = set(python_steps) - {*inputs, refused}

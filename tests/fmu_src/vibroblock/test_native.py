@@ -1,9 +1,11 @@
-"""The NativeStep record: what a native front end reads to advance a Block without Python.
+"""The NativeStep record: what a native front end reads to advance a Block and read its
+outputs without Python.
 
 The front end itself (build/python_runtime.c) is exercised through the FMUs in
 tests/fmu_src/test_block_fmus.py; here the record's contract: its kernel, called with
-its own fields, advances the block exactly as ``advance_to`` does, and the record
-follows the block (not ready before the start, re-pointed when the arrays change).
+its own fields, advances the block exactly as ``advance_to`` does; its observe kernel
+and output table give the block's outputs bit for bit; and the record follows the
+block (not ready before the start, re-pointed when the arrays change).
 """
 import ctypes
 import math
@@ -13,10 +15,16 @@ import pytest
 
 from vibroblock import Block
 from vibroblock import layout as L
-from vibroblock.native import RETURNED_OK, STATUS_SHIFT, NativeStep
+from vibroblock.interface import OUTPUTS
+from vibroblock.native import RETURNED_OK, STATUS_SHIFT, SURFACE_Z, ZERO, NativeStep
 
 ADVANCE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
                            ctypes.c_void_p, ctypes.c_int64, ctypes.c_int64)
+OBSERVE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+                           ctypes.c_void_p, ctypes.c_double, ctypes.c_int64, ctypes.c_void_p)
+# Value references as an FMU would give them (any distinct numbers).
+REFS = {name: 100 + i for i, name in enumerate(OUTPUTS)}
+REAL_OUTPUTS = [name for name, (kind, *_) in OUTPUTS.items() if kind == "Real"]
 
 CASES = [
     ("A", "symplectic_euler", {"A": 0.6, "omega": 1.3}),
@@ -28,11 +36,35 @@ CASES = [
 ]
 
 
-def driven(model, integrator, options, energy=False):
+def driven(model, integrator, options, energy=False, refs=None):
     record = NativeStep()
     block = Block(model, integrator, 2, energy, k_d=1e-2, V_d=1e-2, gamma_t=5e-3, **options)
-    block.drive_natively(record, 1e-9)
+    block.drive_natively(record, 1e-9, refs)
     return block, record
+
+
+def as_array(address, ctype, shape):
+    return np.ctypeslib.as_array(ctypes.cast(address, ctypes.POINTER(ctype)), shape)
+
+
+def native_read(record: NativeStep) -> dict:
+    """What the front end does for a read of every output in the record's table:
+    {value reference: value} from one observe call."""
+    assert record.ready and record.observe
+    cnt = as_array(record.cnt, ctypes.c_int64, (L.N_CNT,))
+    h = record.time - (record.t0 + cnt[record.step_slot] * record.dt)
+    if h < record.grid_tolerance * record.dt:
+        h = 0.0
+    status = OBSERVE(record.observe)(record.flags, record.y, record.cnt, record.drv, record.prm, min(h, record.dt),
+                                     record.track_energy, record.obs)
+    assert status == record.observed_ok
+    obs = as_array(record.obs, ctypes.c_double, (L.N_OBS,))
+    values = {}
+    for vr, source in as_array(record.outputs, ctypes.c_int64, (record.n_outputs, 2)).tolist():
+        assert source in (*range(L.N_OBS), SURFACE_Z, ZERO)
+        values[vr] = (obs[source] if source >= 0 else 0.0 if source == ZERO
+                      else obs[L.O_Z] + obs[L.O_PENETRATION] / obs[L.O_COS])
+    return values
 
 
 def native_advance(record: NativeStep, t_end: float) -> int:
@@ -62,6 +94,35 @@ def test_the_records_kernel_advances_as_advance_to(model, integrator, options):
         assert native.time == t_end  # the block reads its time from the record
         assert native.outputs() == python.outputs()  # and refreshes its outputs with it
     assert native.get_state() == python.get_state()
+
+
+@pytest.mark.parametrize("model, integrator, options", CASES)
+@pytest.mark.parametrize("energy", [False, True])
+def test_the_records_observation_gives_the_outputs(model, integrator, options, energy):
+    """Read through the record at grid points and between them, every Real output the
+    table names has the bits of ``Block.outputs``.  It names them all in the model's own
+    reading, except the energy residual with the energy balance on (a sum Python forms);
+    in another reading (C in the tangent frame here) not the block's height and
+    velocities nor the surface under it, which Python converts from the frame's state."""
+    block, record = driven(model, integrator, options, energy, REFS)
+    block.start()
+    own_reading = "formulation" not in options
+    served = {name for name in REAL_OUTPUTS
+              if (own_reading or name not in ("z", "vx", "vz", "surface_z"))
+              and not (energy and name == "energy_residual")}
+    normal_forces = []
+    for t_end in (0.5, 0.7301, 2.0, 7.3105, 12.5):  # dt = 4e-4 (the default): two ends between grid points
+        block.advance_to(t_end)
+        outputs = block.outputs()
+        assert native_read(record) == {REFS[name]: outputs[name] for name in served}
+        normal_forces.append(outputs["normal_force"])
+    assert max(normal_forces) > 0.0  # some reads in contact
+
+
+def test_a_record_without_output_references_serves_no_reads():
+    block, record = driven("A", "symplectic_euler", {"A": 0.6, "omega": 1.3})
+    block.start()
+    assert record.ready and record.n_outputs == 0
 
 
 def test_a_guard_that_stops_the_kernel_is_reported_to_the_front_end():
