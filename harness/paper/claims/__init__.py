@@ -13,6 +13,7 @@ worker tasks, regime arithmetic), :mod:`.verdicts` (verdict words, Row, toleranc
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from typing import Sequence
 
 from . import (c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery,
@@ -27,39 +28,68 @@ CLAIMS: dict[str, Claim] = {module.CLAIM.name: module.CLAIM for module in (
 STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 
 
+# Studies run side by side on a Dask client.  A study hands its sweeps and tasks to the
+# client and waits for them, so one study alone leaves a core idle whenever it runs a
+# single task (a ramp, a start-phase run, a bisection round of one or two points) or
+# waits for the slowest point of a sweep; several keep every worker busy.
+STUDIES_AT_ONCE = 4
+
+
 def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: bool = True,
-                readings: bool = True) -> dict[str, Study]:
-    """Run the named studies in order, each under every reading its claim lists (only the
-    default one if ``readings`` is false or the resolution measures the default reading
-    only); {study name: Study} (:func:`.readings.study_name`), each with its timing."""
+                readings: bool = True, at_once: int | None = None) -> dict[str, Study]:
+    """Run the named studies, each under every reading its claim lists (only the default
+    one if ``readings`` is false or the resolution measures the default reading only);
+    {study name: Study} (:func:`.readings.study_name`) in that order, each with its
+    timing.  Up to ``at_once`` studies run side by side (default: ``STUDIES_AT_ONCE`` on a
+    Dask client, one at a time inline), each on a runner of its own
+    (:meth:`Runner.for_reading`); their counts are added to ``runner``'s."""
     readings = readings and runner.resolution.readings
     jobs = [(name, reading) for name in names
             for reading in (CLAIMS[name].readings if readings else (DEFAULT_READING,))]
-    results = {}
+    at_once = max(1, at_once or (STUDIES_AT_ONCE if runner.client is not None else 1))
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
         bar = tqdm(total=len(jobs), desc="claims", unit="study", position=0)
+
+    def run_one(name: str, reading) -> tuple[Study, Runner]:
+        # Side by side, the sweeps' own progress bars would overwrite each other.
+        own = runner.for_reading(reading, progress=None if at_once == 1 else False)
+        started = time.perf_counter()
+        study = CLAIMS[name].study(own)
+        study.reading = reading.key
+        spent = counts(own)
+        study.timing = timing(time.perf_counter() - started, dict.fromkeys(spent, 0), spent)
+        return study, own
+
+    results = {}
+
+    def finished(key: str, study: Study, own: Runner) -> None:
+        results[key] = study
+        runner.add_counts(own)
+        if bar is not None:
+            bar.set_postfix_str(key)
+            bar.update(1)
+
     try:
-        for name, reading in jobs:
-            key = study_name(name, reading)
-            if bar is not None:
-                bar.set_postfix_str(key)
-            before, started = counts(runner), time.perf_counter()
-            runner.reading = reading
-            try:
-                results[key] = CLAIMS[name].study(runner)
-            finally:
-                runner.reading = DEFAULT_READING
-            results[key].reading = reading.key
-            results[key].timing = timing(time.perf_counter() - started, before, counts(runner))
-            if bar is not None:
-                bar.update(1)
+        if at_once == 1:  # in this thread (inline, the FMUs run in this process)
+            for name, reading in jobs:
+                finished(study_name(name, reading), *run_one(name, reading))
+        else:
+            with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="study") as pool:
+                futures = {pool.submit(run_one, name, reading): study_name(name, reading) for name, reading in jobs}
+                try:
+                    for future in as_completed(futures):
+                        finished(futures[future], *future.result())
+                except BaseException:
+                    for future in futures:  # the studies not started yet; running ones finish
+                        future.cancel()
+                    raise
     finally:
         if bar is not None:
             bar.close()
-    return results
+    return {study_name(name, reading): results[study_name(name, reading)] for name, reading in jobs}
 
 
 __all__ = ["CLAIMS", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading", "Resolution", "Runner", "STUDIES", "Study", "friction_held",

@@ -14,6 +14,7 @@ the tests'.
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import hashlib
 import json
@@ -172,6 +173,22 @@ class Runner:
                 fields["integration"] = CORRUGATED_INTEGRATION
                 parameters = {**CORRUGATED_TOLERANCES, **parameters}
         return RunSettings(fmu=self.fmus[model], parameters=parameters, **fields)
+
+    def for_reading(self, reading: Reading, progress: bool | None = None) -> "Runner":
+        """A runner on this one's store, resolution, client and FMUs under ``reading``, with
+        counters of its own (so that studies can run side by side); ``progress`` switches
+        its sweeps' progress bars."""
+        other = copy.copy(self)
+        other.reading = reading
+        other.points_computed = other.points_reused = other.tasks_computed = other.tasks_reused = 0
+        if progress is not None:
+            other.execution = dataclasses.replace(self.execution, progress=progress)
+        return other
+
+    def add_counts(self, other: "Runner") -> None:
+        """Count what ``other`` (made by :meth:`for_reading`) computed and reused as this runner's."""
+        for name, value in counts(other).items():
+            setattr(self, name, getattr(self, name) + value)
 
     def sweep(self, grid: Grid, base: PointSettings):
         outcome = run_sweep(grid, base, self.store / "points", self.execution, self.client)

@@ -69,6 +69,36 @@ def test_each_reading_runs_under_its_own_parameters(runner, monkeypatch):
     assert list(run_studies(runner, ["C7"], progress=False)) == ["C7"]
 
 
+def test_studies_side_by_side_keep_their_readings_order_and_counts(runner, monkeypatch):
+    """With several studies at once each runs on a runner of its own under its reading;
+    the results come back in the order of the claims and readings, each study's counts
+    are its own and the caller's runner gets their sum."""
+    import threading
+    import time
+
+    threads, started = set(), threading.Barrier(2, timeout=30)
+
+    def fake_study(name, delay):
+        def study(r):
+            threads.add(threading.current_thread().name)
+            if r.reading == DEFAULT_READING:
+                started.wait()  # the two default-reading studies run at the same time
+            time.sleep(delay)  # and they finish out of order
+            r.points_computed += 2
+            r.tasks_reused += 1
+            return Study(name, {"reading": r.reading.key}, {})
+        return study
+
+    monkeypatch.setitem(CLAIMS, "C7", dataclasses.replace(CLAIMS["C7"], study=fake_study("C7", 0.2)))
+    monkeypatch.setitem(CLAIMS, "C8", dataclasses.replace(CLAIMS["C8"], study=fake_study("C8", 0.0)))
+    studies = run_studies(runner, ["C7", "C8"], progress=False, at_once=4)
+    assert list(studies) == [study_name(c, r) for c in ("C7", "C8") for r in READINGS]
+    assert all(s.measured["reading"] == s.reading == split_study_name(name)[1].key for name, s in studies.items())
+    assert all(s.timing["points_computed"] == 2 and s.timing["tasks_reused"] == 1 for s in studies.values())
+    assert (runner.points_computed, runner.tasks_reused) == (2 * len(studies), len(studies))
+    assert runner.reading == DEFAULT_READING and len(threads) > 1
+
+
 def _c7(fractions: list) -> Study:
     curve = {"A": 0.3, "omega": [0.1, 1.0, 14.0], "contact_fraction": fractions, "regime": ["stick_slip"] * 3}
     return Study("C7", {"curves": {"B": [curve], "C": [curve]}, "k_n_over_gamma_n": 14.3,
