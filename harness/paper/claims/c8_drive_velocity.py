@@ -141,15 +141,15 @@ def draw(study: Study, save) -> None:
     d = study.data
     for key, name, title in (("regime_c", "model_c_Vd_omega.png", "Model C (the paper's Fig. 7)"),
                              ("regime_a", "model_a_Vd_omega.png", "Model A (scaled parameters)")):
-        fig, ax = plt.subplots(figsize=(6, 4.5))
+        fig, ax = plt.subplots(figsize=(8.5, 4.5))
         omega, velocity = np.meshgrid(d["omega"], d["V_d"])
         regime_scatter(ax, omega.ravel(), velocity.ravel(), np.asarray(d[key]).ravel())
         amplitude = study.measured["model_c_amplitude" if key == "regime_c" else "model_a_amplitude"]
         ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="$V_d$", title=f"{title}, A = {amplitude:g}"
-               + ("\nscaled $k_d = 10^{-2}$, $\\gamma_t = 5\\cdot10^{-3}$ on the paper's plate; the paper's "
+               + ("\nscaled $k_d = 10^{-2}$, $\\gamma_t = 5\\cdot10^{-3}$ on the paper's plate;\nthe paper's "
                   "A = 2e4 throws the block off the plate" if key == "regime_c" else ""))
         ax.title.set_fontsize(8)
-        ax.legend(fontsize="small")
+        ax.legend(fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.5))  # beside the grid, not over it
         save(fig, name)
 
 
