@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import Sequence
 
-from .claims import CLAIMS, DEFAULT_READING, READINGS, Study, study_name
+from .claims import CLAIMS, DEFAULT_READING, READINGS, STUDIES_AT_ONCE, Study, study_name
 from .claims.verdicts import AGREES, DISAGREES, FLIPS, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row
 
 CLAIM_TEXT = {part: text for claim in CLAIMS.values() for part, text in claim.text.items()}
@@ -146,7 +146,8 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
                      f"min slip fraction {study.settings.get('slip_min_fraction', 'n/a')} |")
     timed = {name: study.timing for name, study in studies.items() if study.timing}
     if timed:
-        lines += ["", "## Time per study", "", "| study | wall time | from | points computed / from the store | "
+        lines += ["", "## Time per study", "", f"Studies run side by side (up to {STUDIES_AT_ONCE} at once on a Dask client), so their "
+                  "wall times overlap.", "", "| study | wall time | from | points computed / from the store | "
                   "runs and ramps computed / from the store |", "|---|---|---|---|---|"]
         lines += [f"| {name} | {t['wall_time']:.1f} s | {t['source']} | {t['points_computed']} / {t['points_reused']} "
                   f"| {t['tasks_computed']} / {t['tasks_reused']} |" for name, t in timed.items()]

@@ -302,7 +302,8 @@ def test_plain_do_steps_run_without_python_and_give_the_same_bits(extracted, fmu
     The outputs read after each step come from the record's observation without Python;
     in a reading other than the model's own (B here: the tangent frame) Python converts
     the block's height and velocities and the surface under it, so a read that asks for
-    any of them goes to Python whole.  Left to pythonfmu (every doStep and read a Python call) the run has the same bits."""
+    any of them goes to Python whole.  Left to pythonfmu (every doStep and read a Python
+    call) the run has the same bits."""
     native, python_steps, python_reads = scripted_run(extracted, fmu_log, model, settings)
     monkeypatch.setenv("VIBROBLOCK_PYTHONFMU_DOSTEP", "1")
     through_python, every_step, every_read = scripted_run(extracted, fmu_log, model, settings)
