@@ -508,7 +508,8 @@ typedef struct {
     int64_t n_outputs;
 } NativeStep;
 
-/* Observation slots the computed outputs use (vibroblock/layout.py). */
+/* Observation slots the computed outputs use: vibroblock/layout.py's O_*, which the FMU
+ * tests hold to (surface_z read here and through pythonfmu, compared bit for bit). */
 enum { O_Z = 1, O_PENETRATION = 5, O_COS = 7, N_OBS = 16 };
 
 /* The slave's record (its attribute native_step, the address), or NULL. */

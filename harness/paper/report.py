@@ -146,8 +146,9 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
                      f"min slip fraction {study.settings.get('slip_min_fraction', 'n/a')} |")
     timed = {name: study.timing for name, study in studies.items() if study.timing}
     if timed:
-        lines += ["", "## Time per study", "", f"Studies run side by side (up to {STUDIES_AT_ONCE} at once on a Dask client), so their "
-                  "wall times overlap.", "", "| study | wall time | from | points computed / from the store | "
+        lines += ["", "## Time per study", "",
+                  f"On a Dask client up to {STUDIES_AT_ONCE} studies run side by side, so their wall times overlap.",
+                  "", "| study | wall time | from | points computed / from the store | "
                   "runs and ramps computed / from the store |", "|---|---|---|---|---|"]
         lines += [f"| {name} | {t['wall_time']:.1f} s | {t['source']} | {t['points_computed']} / {t['points_reused']} "
                   f"| {t['tasks_computed']} / {t['tasks_reused']} |" for name, t in timed.items()]

@@ -92,7 +92,6 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
     return {study_name(name, reading): results[study_name(name, reading)] for name, reading in jobs}
 
 
-__all__ = ["CLAIMS", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading", "Resolution", "Runner", "STUDIES",
-           "STUDIES_AT_ONCE", "Study", "friction_held",
-           "load_studies", "onset_amplitude", "recovery", "run_studies", "save_studies", "split_study_name",
-           "stable_roots_near", "study_name", "transition_bracket"]
+__all__ = ["CLAIMS", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading", "Resolution", "Runner",
+           "STUDIES", "STUDIES_AT_ONCE", "Study", "friction_held", "load_studies", "onset_amplitude", "recovery",
+           "run_studies", "save_studies", "split_study_name", "stable_roots_near", "study_name", "transition_bracket"]
