@@ -64,6 +64,7 @@ def main(argv: list[str] | None = None) -> Path:
     elapsed = time.perf_counter() - started
     header = {"resolution": resolution.name, "points computed / reused from the store":
               f"{runner.points_computed} / {runner.points_reused}", "wall time": f"{elapsed:.0f} s",
+              "compute time (summed over the workers)": f"{runner.compute_time:.0f} s",
               "integrators": f"model A {MODEL_A_INTEGRATOR} (symplectic_euler under the applied-load bound, which "
                              f"it does not offer), models B and C {CORRUGATED_INTEGRATION.describe()} (adaptive: "
                              + ", ".join(f"{k} {v:g}" for k, v in CORRUGATED_TOLERANCES.items())

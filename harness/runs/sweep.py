@@ -408,6 +408,7 @@ class SweepOutcome:
     computed: int = 0
     reused: int = 0
     failures: list = field(default_factory=list)
+    compute_time: float = 0.0   # seconds the computed points took, summed where they ran
 
 
 def run_sweep(grid: Grid, base: PointSettings = PointSettings(), store: PointStore | str | os.PathLike | None = None,
@@ -437,6 +438,7 @@ def run_sweep(grid: Grid, base: PointSettings = PointSettings(), store: PointSto
         if store is not None:
             store.save(point.key, point.inputs, result["observables"], result["elapsed_s"])
         outcome.computed += 1
+        outcome.compute_time += result["elapsed_s"]
 
     bar = _progress(execution.progress, len(todo), outcome.reused)
     try:

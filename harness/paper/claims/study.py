@@ -19,6 +19,7 @@ import dataclasses
 import hashlib
 import json
 import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
@@ -149,6 +150,9 @@ class Runner:
         self.points_reused = 0
         self.tasks_computed = 0
         self.tasks_reused = 0
+        # Seconds the workers spent on the points and tasks this runner computed: with
+        # studies side by side, a study's own cost (its wall time overlaps the others').
+        self.compute_time = 0.0
         self.reading: Reading = DEFAULT_READING
 
     def run(self, model: str, **fields) -> RunSettings:
@@ -181,6 +185,7 @@ class Runner:
         other = copy.copy(self)
         other.reading = reading
         other.points_computed = other.points_reused = other.tasks_computed = other.tasks_reused = 0
+        other.compute_time = 0.0
         if progress is not None:
             other.execution = dataclasses.replace(self.execution, progress=progress)
         return other
@@ -194,10 +199,12 @@ class Runner:
         outcome = run_sweep(grid, base, self.store / "points", self.execution, self.client)
         self.points_computed += outcome.computed
         self.points_reused += outcome.reused
+        self.compute_time += outcome.compute_time
         return outcome.dataset
 
     def tasks(self, function: Callable, items: Sequence[dict]) -> list[dict]:
-        """``function(item, pool)`` for every item, cached by (function, item, FMU hashes)."""
+        """``function(item, pool)`` for every item, cached by (function, item, FMU hashes)
+        with the seconds it took (``elapsed_s``) beside the result."""
         folder = self.store / "studies"
         keys = []
         for item in items:
@@ -213,23 +220,39 @@ class Runner:
         self.tasks_computed += len(missing)
         self.tasks_reused += len(items) - len(missing)
         if missing:
-            computed = map_with_pool(function, [items[n] for n in missing], self.execution, self.client)
-            for number, result in zip(missing, computed):
-                write_json_atomically(folder / f"{keys[number]}.json", {"item": to_jsonable(items[number]),
-                                                                        "result": result})
-                results[number] = result
+            computed = map_with_pool(_Timed(function), [items[n] for n in missing], self.execution, self.client)
+            for number, timed in zip(missing, computed):
+                write_json_atomically(folder / f"{keys[number]}.json", {"item": to_jsonable(items[number]), **timed})
+                results[number] = timed["result"]
+                self.compute_time += timed["elapsed_s"]
         return [results[n] for n in range(len(items))]
 
 
+@dataclass(frozen=True)
+class _Timed:
+    """``function(item, pool)`` as ``{"result": ..., "elapsed_s": seconds}``, timed where
+    it runs (on a Dask worker, its own time, not the study's wait)."""
+
+    function: Callable
+
+    def __call__(self, item, pool) -> dict:
+        started = time.perf_counter()
+        result = self.function(item, pool)
+        return {"result": result, "elapsed_s": time.perf_counter() - started}
+
+
 def counts(runner: Runner) -> dict:
-    """What the runner has computed and reused from its store so far."""
+    """What the runner has computed and reused from its store so far, and the seconds the
+    computing took (``compute_time``, summed over points and tasks)."""
     return {"points_computed": runner.points_computed, "points_reused": runner.points_reused,
-            "tasks_computed": runner.tasks_computed, "tasks_reused": runner.tasks_reused}
+            "tasks_computed": runner.tasks_computed, "tasks_reused": runner.tasks_reused,
+            "compute_time": runner.compute_time}
 
 
 def timing(wall_time: float, before: dict, after: dict) -> dict:
-    """A study's wall time and its points and tasks computed or read from the store, from the
-    runner's :func:`counts` before and after it; ``source`` says where its results came from."""
+    """A study's wall time, its points and tasks computed or read from the store and the
+    compute time they took, from the runner's :func:`counts` before and after it;
+    ``source`` says where its results came from."""
     spent = {key: after[key] - before[key] for key in after}
     computed = spent["points_computed"] + spent["tasks_computed"]
     reused = spent["points_reused"] + spent["tasks_reused"]

@@ -2,6 +2,8 @@
 are tested on synthetic values in tests/harness/paper/claims/."""
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from harness.paper import report
@@ -70,6 +72,13 @@ def test_each_study_reports_its_time_and_a_rerun_comes_from_the_store(tiny_job, 
     first = load_studies(out / "claims.json")
     assert all(s.timing["wall_time"] > 0 and s.timing["source"] != "store" for s in first.values())
     assert "## Time per study" in path.read_text()
+    # Each point and task the job computed is counted once, in the study that computed it,
+    # with the time stored beside its result.
+    stored = [json.loads(f.read_text())["elapsed_s"] for f in (out / "store").glob("*/**/*.json")
+              if "elapsed_s" in json.loads(f.read_text())]
+    assert len(stored) == sum(s.timing["points_computed"] + s.timing["tasks_computed"] for s in first.values())
+    assert sum(s.timing["compute_time"] for s in first.values()) == pytest.approx(sum(stored), rel=1e-9)
+    assert all(s.timing["compute_time"] > 0 for s in first.values() if s.timing["source"] == "computed")
     capsys.readouterr()
     main(["--resolution", "tiny", "--scheduler", "inline", "--out", str(out), "--fmu-dir", str(fmu_dir), "--no-progress"])
     printed = capsys.readouterr().out
@@ -77,4 +86,5 @@ def test_each_study_reports_its_time_and_a_rerun_comes_from_the_store(tiny_job, 
     for name, study in again.items():
         assert study.timing["source"] == "store", name
         assert study.timing["points_computed"] == study.timing["tasks_computed"] == 0
-        assert f"{name}: {study.timing['wall_time']:.1f} s (store;" in printed
+        assert study.timing["compute_time"] == 0.0
+        assert f"{name}: {study.timing['wall_time']:.1f} s, computing 0.0 s (store;" in printed
