@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import Sequence
 
-from .claims import CLAIMS, DEFAULT_READING, READINGS, STUDIES_AT_ONCE, Study, study_name
+from .claims import CLAIMS, DEFAULT_READING, READINGS, Study, study_name
 from .claims.verdicts import AGREES, DISAGREES, FLIPS, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row
 
 CLAIM_TEXT = {part: text for claim in CLAIMS.values() for part, text in claim.text.items()}
@@ -147,7 +147,7 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
     timed = {name: study.timing for name, study in studies.items() if study.timing}
     if timed:
         lines += ["", "## Time per study", "",
-                  f"On a Dask client up to {STUDIES_AT_ONCE} studies run side by side, so their wall times overlap; "
+                  "On a Dask client the studies run side by side, so their wall times overlap; "
                   "the compute time is a study's own cost: the seconds the workers spent on the points and runs "
                   "it computed.", "",
                   "| study | wall time | compute time | from | points computed / from the store | "

@@ -111,8 +111,9 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
                        help="internal integrator, as the FMU names it (default symplectic_euler)")
     group.add_argument("--dt", type=float, default=4e-4, help="internal step (default 4e-4)")
     group.add_argument("--switch", action="append", default=[], type=_limit, metavar="NAME=LIMIT",
-                       help="with --integrator-above (repeatable): a run in which parameter NAME exceeds LIMIT "
-                            "uses --integrator-above instead of --integrator, chosen per sweep point, e.g. "
+                       help="with --integrator-above (repeatable): a run in which NAME (a parameter, or "
+                            "plate_speed = A omega) exceeds LIMIT uses --integrator-above instead of --integrator, "
+                            "chosen per sweep point, e.g. "
                             "--integrator adaptive --switch omega=2 --integrator-above symplectic_euler "
                             "(README, 'Choosing speed or accuracy')")
     group.add_argument("--integrator-above", default=None, choices=_choices("integrator"),

@@ -98,12 +98,20 @@ class Parameters(Mapping):
         return Parameters({**dict(self._items), **dict(values or {}), **more})
 
 
+# What an integration's switch can name besides the FMU's parameters: name -> (the
+# parameters it is computed from, how).  The plate's peak speed A omega measures how hard
+# the block is struck at each landing, which is what an error-controlled integrator pays
+# for (README, "Choosing speed or accuracy").
+SWITCH_QUANTITIES = {"plate_speed": (("A", "omega"), lambda amplitude, omega: amplitude * omega)}
+
+
 @dataclass(frozen=True)
 class Integration:
     """The FMU's internal integrator and step, optionally switched by parameter values.
 
-    With ``switch`` (pairs of parameter name and limit), a run in which any of those
-    parameters exceeds its limit uses ``integrator_above`` instead of ``integrator``: no
+    With ``switch`` (pairs of name and limit), a run in which any of those values exceeds
+    its limit uses ``integrator_above`` instead of ``integrator``.  A name is a parameter
+    or one of :data:`SWITCH_QUANTITIES` (e.g. ``plate_speed``, A omega).  No
     integrator is the cheapest everywhere (README, "Choosing speed or accuracy":
     ``adaptive`` spends its steps on the plate's cycles and on the surface's crests, the
     fixed-step schemes on the contact's period), so a sweep can run each point with the
@@ -132,10 +140,20 @@ class Integration:
 
     def for_values(self, values: Mapping) -> str:
         """The integrator of a run with these parameter values."""
-        missing = [name for name, _ in self.switch if name not in values]
+        needed = {name: SWITCH_QUANTITIES[name][0] if name in SWITCH_QUANTITIES else (name,)
+                  for name, _ in self.switch}
+        missing = [name for name, inputs in needed.items() if any(i not in values for i in inputs)]
         if missing:
-            raise ValueError(f"an integration switched by {', '.join(missing)} needs the run's value of it")
-        above = any(values[name] > limit for name, limit in self.switch)
+            raise ValueError(f"an integration switched by {', '.join(missing)} needs the run's value of "
+                             + ", ".join(sorted({i for n in missing for i in needed[n]})))
+
+        def value(name):
+            if name in SWITCH_QUANTITIES:
+                inputs, function = SWITCH_QUANTITIES[name]
+                return function(*(values[i] for i in inputs))
+            return values[name]
+
+        above = any(value(name) > limit for name, limit in self.switch)
         return self.integrator_above if above else self.integrator
 
     def describe(self) -> str:

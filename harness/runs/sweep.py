@@ -262,6 +262,9 @@ class Execution:
     progress: bool = True
     cache: str = str(DEFAULT_CACHE)
     numba_cache_dir: str | None = None
+    # Dask priority of the points and tasks submitted: among those ready, higher runs
+    # first (work that others wait on, e.g. a study's chain of bisection rounds).
+    priority: int = 0
 
     def numba_cache(self) -> str:
         return self.numba_cache_dir or os.environ.get("NUMBA_CACHE_DIR") or str(REPO_ROOT / ".cache" / "numba")
@@ -351,7 +354,8 @@ def map_with_pool(function, items: Sequence, execution: Execution = Execution(),
         client = open_client(execution)
     try:
         client.register_plugin(FmuPoolPlugin(execution.cache, execution.numba_cache()), name=POOL_PLUGIN)
-        futures = [client.submit(_call_with_worker_pool, function, item, pure=False) for item in items]
+        futures = [client.submit(_call_with_worker_pool, function, item, pure=False, priority=execution.priority)
+                   for item in items]
         bar = _progress(execution.progress, len(items), 0) if execution.progress else None
         try:
             from distributed import as_completed
@@ -471,7 +475,7 @@ def _run_on_dask(todo, sha256, execution, client, finished, outcome, bar) -> Non
         client.register_plugin(FmuPoolPlugin(execution.cache, execution.numba_cache()), name=POOL_PLUGIN)
         futures = {}
         for point in todo:
-            future = client.submit(evaluate_on_worker, point.settings, sha256, pure=False,
+            future = client.submit(evaluate_on_worker, point.settings, sha256, pure=False, priority=execution.priority,
                                    key=f"vibroblock-point-{point.key[:16]}-{time.monotonic_ns()}")
             futures[future] = point
         for future in as_completed(list(futures), loop=client.loop):

@@ -28,11 +28,20 @@ CLAIMS: dict[str, Claim] = {module.CLAIM.name: module.CLAIM for module in (
 STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 
 
-# Studies run side by side on a Dask client.  A study hands its sweeps and tasks to the
-# client and waits for them, so one study alone leaves a core idle whenever it runs a
-# single task (a ramp, a start-phase run, a bisection round of one or two points) or
-# waits for the slowest point of a sweep; several keep every worker busy.
-STUDIES_AT_ONCE = 4
+# On a Dask client every study runs at once, each in a thread of its own that hands its
+# sweeps and tasks to the client and waits for them: one study alone would leave a core
+# idle whenever it runs a single task (a ramp, a start-phase run, a bisection round of one
+# or two points) or waits for the slowest point of a sweep.  The workers take the ready
+# work of the costliest studies first (their Dask priority), so that those studies'
+# chains of dependent rounds (sweep, bisection, start ensemble) and their longest single
+# runs do not trail at the end while the cheap studies fill the gaps.  The order is that
+# of the compute time each study took in the main job at the default resolution (README).
+COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "C3", "C8", "C4", "C7", "C5", "C2", "Fig1b", "C1")
+
+
+def priority(name: str) -> int:
+    """The Dask priority of claim ``name``'s work: higher for a costlier study, 0 if unranked."""
+    return len(COSTLIEST_FIRST) - COSTLIEST_FIRST.index(name) if name in COSTLIEST_FIRST else 0
 
 
 def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: bool = True,
@@ -40,13 +49,13 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
     """Run the named studies, each under every reading its claim lists (only the default
     one if ``readings`` is false or the resolution measures the default reading only);
     {study name: Study} (:func:`.readings.study_name`) in that order, each with its
-    timing.  Up to ``at_once`` studies run side by side (default: ``STUDIES_AT_ONCE`` on a
-    Dask client, one at a time inline), each on a runner of its own
+    timing.  Up to ``at_once`` studies run side by side (default: all of them on a Dask
+    client, with :func:`priority`; one at a time inline), each on a runner of its own
     (:meth:`Runner.for_reading`); their counts are added to ``runner``'s."""
     readings = readings and runner.resolution.readings
     jobs = [(name, reading) for name in names
             for reading in (CLAIMS[name].readings if readings else (DEFAULT_READING,))]
-    at_once = max(1, at_once or (STUDIES_AT_ONCE if runner.client is not None else 1))
+    at_once = max(1, at_once or (len(jobs) if runner.client is not None else 1))
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -55,7 +64,7 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
 
     def run_one(name: str, reading) -> tuple[Study, Runner]:
         # Side by side, the sweeps' own progress bars would overwrite each other.
-        own = runner.for_reading(reading, progress=None if at_once == 1 else False)
+        own = runner.for_reading(reading, progress=None if at_once == 1 else False, priority=priority(name))
         started = time.perf_counter()
         study = CLAIMS[name].study(own)
         study.reading = reading.key
@@ -78,7 +87,8 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
                 finished(study_name(name, reading), *run_one(name, reading))
         else:
             with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="study") as pool:
-                futures = {pool.submit(run_one, name, reading): study_name(name, reading) for name, reading in jobs}
+                futures = {pool.submit(run_one, name, reading): study_name(name, reading)
+                           for name, reading in sorted(jobs, key=lambda job: -priority(job[0]))}
                 try:
                     for future in as_completed(futures):
                         finished(futures[future], *future.result())
@@ -93,5 +103,5 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
 
 
 __all__ = ["CLAIMS", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading", "Resolution", "Runner",
-           "STUDIES", "STUDIES_AT_ONCE", "Study", "friction_held", "load_studies", "onset_amplitude", "recovery",
+           "STUDIES", "COSTLIEST_FIRST", "Study", "friction_held", "load_studies", "onset_amplitude", "priority", "recovery",
            "run_studies", "save_studies", "split_study_name", "stable_roots_near", "study_name", "transition_bracket"]

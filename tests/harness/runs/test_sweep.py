@@ -78,6 +78,16 @@ def test_an_integration_switched_by_omega_runs_each_point_with_its_own_integrato
         Integration("adaptive", switch=(("omega", 1.0),))
 
 
+def test_a_switch_on_the_plate_speed_compares_a_omega_with_its_limit():
+    switched = Integration("adaptive", switch=(("plate_speed", 16.0),), integrator_above="symplectic_euler")
+    choose = lambda a, w: RunSettings(integration=switched).fmu_values({"A": a, "omega": w})["integrator"]  # noqa: E731
+    assert [choose(10.0, 1.5), choose(10.0, 1.7), choose(0.3, 50.0), choose(0.3, 53.4)] == [
+        "adaptive", "symplectic_euler", "adaptive", "symplectic_euler"]
+    assert "plate_speed <= 16" in switched.describe()
+    with pytest.raises(ValueError, match="switched by plate_speed needs the run's value of A, omega"):
+        RunSettings(integration=switched).fmu_values()
+
+
 def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a):
     grid = Grid.parse(["A=0,3.5", "omega=0.5,0.9"])
     base = base_point(fmu_a)

@@ -76,11 +76,12 @@ def test_studies_side_by_side_keep_their_readings_order_and_counts(runner, monke
     import threading
     import time
 
-    threads, started = set(), threading.Barrier(2, timeout=30)
+    threads, started, priorities = set(), threading.Barrier(2, timeout=30), {}
 
     def fake_study(name, delay):
         def study(r):
             threads.add(threading.current_thread().name)
+            priorities[name] = r.execution.priority
             if r.reading == DEFAULT_READING:
                 started.wait()  # the two default-reading studies run at the same time
             time.sleep(delay)  # and they finish out of order
@@ -97,6 +98,8 @@ def test_studies_side_by_side_keep_their_readings_order_and_counts(runner, monke
     assert all(s.timing["points_computed"] == 2 and s.timing["tasks_reused"] == 1 for s in studies.values())
     assert (runner.points_computed, runner.tasks_reused) == (2 * len(studies), len(studies))
     assert runner.reading == DEFAULT_READING and len(threads) > 1
+    # The costlier study's work goes first on the workers; the caller's runner keeps its own.
+    assert priorities["C8"] > priorities["C7"] > runner.execution.priority == 0
 
 
 def _c7(fractions: list) -> Study:
