@@ -80,13 +80,18 @@ class PointStore:
         self.points = self.root / "points"
         self.sweeps = self.root / "sweeps"
         marker = self.root / "store.json"
+        # The folder's contents are listed before the marker is looked for: a store writes
+        # its marker before anything else, so a folder seen with contents and then found
+        # without a marker is not a store, even while another thread or process is
+        # creating this one (its marker, then its folders).
+        contents = [p for p in self.root.iterdir() if not p.name.startswith(".")] if self.root.exists() else []
         if marker.is_file():
             found = json.loads(marker.read_text())
             if found != STORE_FORMAT:
                 raise StoreMismatch(f"{self.root} is a store of format {found}, this harness reads {STORE_FORMAT}")
+        elif contents:
+            raise StoreMismatch(f"{self.root} exists and is not a point store; choose an empty or new folder")
         else:
-            if self.root.exists() and any(p for p in self.root.iterdir() if not p.name.startswith(".")):
-                raise StoreMismatch(f"{self.root} exists and is not a point store; choose an empty or new folder")
             write_json_atomically(marker, STORE_FORMAT)
         self.points.mkdir(parents=True, exist_ok=True)
         self.sweeps.mkdir(parents=True, exist_ok=True)

@@ -133,6 +133,19 @@ def test_a_folder_that_is_not_a_store_is_refused(tmp_path):
         PointStore(tmp_path)
 
 
+def test_studies_side_by_side_open_one_new_store_at_once(tmp_path):
+    """Threads that open the same new store together (the main job's studies) all get it:
+    none mistakes the folders another is creating for a foreign folder."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    for attempt in range(40):
+        root = tmp_path / f"store{attempt}"
+        with ThreadPoolExecutor(8) as pool:
+            stores = list(pool.map(lambda _: PointStore(root), range(8)))
+        assert all(s.points.is_dir() for s in stores)
+        assert json.loads((root / "store.json").read_text())["format"] == "vibroblock-point-store"
+
+
 def test_a_damaged_point_file_is_moved_aside_and_recomputed(tmp_path):
     from harness.runs.store import PointStore, point_key
 
