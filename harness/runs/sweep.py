@@ -475,8 +475,10 @@ def _run_on_dask(todo, sha256, execution, client, finished, outcome, bar) -> Non
         client.register_plugin(FmuPoolPlugin(execution.cache, execution.numba_cache()), name=POOL_PLUGIN)
         futures = {}
         for point in todo:
+            # The key is the point's own (its inputs' hash): sweeps that ask for the same
+            # point at once, e.g. studies side by side, share its one evaluation.
             future = client.submit(evaluate_on_worker, point.settings, sha256, pure=False, priority=execution.priority,
-                                   key=f"vibroblock-point-{point.key[:16]}-{time.monotonic_ns()}")
+                                   key=f"vibroblock-point-{point.key}")
             futures[future] = point
         for future in as_completed(list(futures), loop=client.loop):
             point = futures.pop(future)

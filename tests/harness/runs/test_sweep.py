@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import os
 
 import numpy as np
@@ -88,7 +89,9 @@ def test_a_switch_on_the_plate_speed_compares_a_omega_with_its_limit():
         RunSettings(integration=switched).fmu_values()
 
 
-def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a):
+def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a, tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
     grid = Grid.parse(["A=0,3.5", "omega=0.5,0.9"])
     base = base_point(fmu_a)
     client = open_client(Execution(workers=2))
@@ -96,8 +99,17 @@ def test_a_small_sweep_on_dask_equals_the_points_run_directly(fmu_a):
         outcome = run_sweep(grid, base, None, Execution(progress=False), client=client)
         loads = worker_pool_loads(client)
         worker_numba = set(client.run(lambda: os.environ.get("NUMBA_CACHE_DIR")).values())
+        # Two sweeps asking for the same points at once (studies side by side) share each
+        # point's one evaluation: both stores hold the same measured time for it.
+        with ThreadPoolExecutor(2) as pool:
+            twins = list(pool.map(lambda n: run_sweep(grid, base, tmp_path / f"store{n}", Execution(progress=False),
+                                                      client=client), range(2)))
     finally:
         close_client(client)
+    assert [t.computed for t in twins] == [4, 4]
+    times = [sorted(json.loads(f.read_text())["elapsed_s"] for f in (tmp_path / f"store{n}" / "points").glob("*.json"))
+             for n in range(2)]
+    assert len(times[0]) == 4 and times[0] == times[1]
     assert outcome.computed == 4 and outcome.reused == 0
     # 4 points on 2 workers: some worker evaluated several, and none loaded the FMU twice.
     assert sorted(loads.values()) in ([1, 1], [0, 1])
