@@ -34,9 +34,12 @@ STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 # or two points) or waits for the slowest point of a sweep.  The workers take the ready
 # work of the costliest studies first (their Dask priority), so that those studies'
 # chains of dependent rounds (sweep, bisection, start ensemble) and their longest single
-# runs do not trail at the end while the cheap studies fill the gaps.  The order is that
-# of the compute time each study took in the main job at the default resolution (README).
-COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "C3", "C8", "C4", "C7", "C5", "C2", "Fig1b", "C1")
+# runs do not trail at the end while the cheap studies fill the gaps.  The order follows
+# the compute time of each claim's study under one reading in the main job at the default
+# resolution (README: C6 ~370 s, C6r ~330 s, Fig. 1c ~300 s, C8 100-130 s, C3 ~100 s,
+# C4 ~75 s, C7 40-60 s, C5 20-30 s, then seconds), with Fig. 1c ahead of C6r: its
+# runs of the paper's drive (up to 85 s each) are the job's longest single tasks.
+COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "C8", "C3", "C4", "C7", "C5", "C2", "C1", "Fig1b")
 
 
 def priority(name: str) -> int:
@@ -102,6 +105,7 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
     return {study_name(name, reading): results[study_name(name, reading)] for name, reading in jobs}
 
 
-__all__ = ["CLAIMS", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading", "Resolution", "Runner",
-           "STUDIES", "COSTLIEST_FIRST", "Study", "friction_held", "load_studies", "onset_amplitude", "priority", "recovery",
-           "run_studies", "save_studies", "split_study_name", "stable_roots_near", "study_name", "transition_bracket"]
+__all__ = ["CLAIMS", "COSTLIEST_FIRST", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading",
+           "Resolution", "Runner", "STUDIES", "Study", "friction_held", "load_studies", "onset_amplitude", "priority",
+           "recovery", "run_studies", "save_studies", "split_study_name", "stable_roots_near", "study_name",
+           "transition_bracket"]
