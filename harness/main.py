@@ -18,7 +18,7 @@ import sys
 import time
 from pathlib import Path
 
-from harness.paper.claims import RESOLUTIONS, Runner, run_studies, save_studies
+from harness.paper.claims import RESOLUTIONS, Runner, StudiesFailed, run_studies, save_studies
 from harness.paper.claims.study import CORRUGATED_INTEGRATION, CORRUGATED_TOLERANCES, MODEL_A_INTEGRATOR
 from harness.cosim.fmu import REPO_ROOT
 from harness.paper.report import timing_lines, write_report
@@ -57,6 +57,8 @@ def main(argv: list[str] | None = None) -> Path:
         fmus = {m: args.fmu_dir / f"Block{m}.fmu" for m in "ABC"} if args.fmu_dir else None
         runner = Runner(out / "store", resolution, execution, client, fmus)
         studies = run_studies(runner, progress=not args.no_progress, readings=not args.default_reading_only)
+    except StudiesFailed as exc:
+        raise SystemExit(f"python -m harness.main: {exc}") from exc
     finally:
         if client is not None:
             close_client(client)

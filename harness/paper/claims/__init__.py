@@ -12,6 +12,7 @@ worker tasks, regime arithmetic), :mod:`.verdicts` (verdict words, Row, toleranc
 """
 from __future__ import annotations
 
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from typing import Sequence
@@ -92,20 +93,43 @@ def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: 
             with ThreadPoolExecutor(max_workers=at_once, thread_name_prefix="study") as pool:
                 futures = {pool.submit(run_one, name, reading): study_name(name, reading)
                            for name, reading in sorted(jobs, key=lambda job: -priority(job[0]))}
+                failed = []
                 try:
                     for future in as_completed(futures):
-                        finished(futures[future], *future.result())
+                        try:
+                            finished(futures[future], *future.result())
+                        except Exception as exc:
+                            # The others go on: what they compute is stored, so that a
+                            # rerun has only the failed studies left to compute.
+                            failed.append((futures[future], exc))
+                            print(f"study {futures[future]} failed ({type(exc).__name__}: {exc}); the other studies "
+                                  "go on", file=sys.stderr, flush=True)
                 except BaseException:
                     for future in futures:  # the studies not started yet; running ones finish
                         future.cancel()
                     raise
+                if failed:
+                    raise StudiesFailed(failed) from failed[0][1]
     finally:
         if bar is not None:
             bar.close()
     return {study_name(name, reading): results[study_name(name, reading)] for name, reading in jobs}
 
 
+class StudiesFailed(RuntimeError):
+    """Studies that raised while others ran beside them (which finished and stored their
+    results); ``failures``: (study name, exception) pairs."""
+
+    def __init__(self, failures: list):
+        self.failures = failures
+        names = ", ".join(name for name, _ in failures)
+        first = failures[0][1]
+        super().__init__(f"{len(failures)} stud{'y' if len(failures) == 1 else 'ies'} failed ({names}); the first: "
+                         f"{type(first).__name__}: {first}. The other studies' results are in the store: "
+                         "run again to retry the failed ones.")
+
+
 __all__ = ["CLAIMS", "COSTLIEST_FIRST", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading",
-           "Resolution", "Runner", "STUDIES", "Study", "friction_held", "load_studies", "onset_amplitude", "priority",
+           "Resolution", "Runner", "STUDIES", "StudiesFailed", "Study", "friction_held", "load_studies", "onset_amplitude", "priority",
            "recovery", "run_studies", "save_studies", "split_study_name", "stable_roots_near", "study_name",
            "transition_bracket"]

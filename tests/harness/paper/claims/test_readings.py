@@ -102,6 +102,33 @@ def test_studies_side_by_side_keep_their_readings_order_and_counts(runner, monke
     assert priorities["C8"] > priorities["C7"] > runner.execution.priority == 0
 
 
+def test_a_study_that_fails_beside_others_lets_them_finish_and_is_named(runner, monkeypatch, capsys):
+    from harness.paper.claims import StudiesFailed
+
+    finished = []
+
+    def failing(r):
+        if r.reading != DEFAULT_READING:
+            raise ValueError("no such point")
+        return Study("C7", {}, {})
+
+    def slow(r):
+        import time
+
+        time.sleep(0.3)  # still running when the C7 studies fail
+        finished.append(r.reading)
+        return Study("C8", {}, {})
+
+    monkeypatch.setitem(CLAIMS, "C7", dataclasses.replace(CLAIMS["C7"], study=failing))
+    monkeypatch.setitem(CLAIMS, "C8", dataclasses.replace(CLAIMS["C8"], study=slow))
+    with pytest.raises(StudiesFailed, match=r"3 studies failed \(C7@.*\); the first: ValueError: no such point") as caught:
+        run_studies(runner, ["C7", "C8"], progress=False, at_once=8)
+    assert sorted(name for name, _ in caught.value.failures) == sorted(
+        study_name("C7", r) for r in READINGS if r != DEFAULT_READING)
+    assert len(finished) == len(READINGS)  # every C8 study ran to its end
+    assert capsys.readouterr().err.count("failed (ValueError: no such point); the other studies go on") == 3
+
+
 def _c7(fractions: list) -> Study:
     curve = {"A": 0.3, "omega": [0.1, 1.0, 14.0], "contact_fraction": fractions, "regime": ["stick_slip"] * 3}
     return Study("C7", {"curves": {"B": [curve], "C": [curve]}, "k_n_over_gamma_n": 14.3,
