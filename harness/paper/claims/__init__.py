@@ -130,6 +130,6 @@ class StudiesFailed(RuntimeError):
 
 
 __all__ = ["CLAIMS", "COSTLIEST_FIRST", "Claim", "DEFAULT_READING", "READINGS", "RESOLUTIONS", "Reading",
-           "Resolution", "Runner", "STUDIES", "StudiesFailed", "Study", "friction_held", "load_studies", "onset_amplitude", "priority",
-           "recovery", "run_studies", "save_studies", "split_study_name", "stable_roots_near", "study_name",
-           "transition_bracket"]
+           "Resolution", "Runner", "STUDIES", "StudiesFailed", "Study", "friction_held", "load_studies",
+           "onset_amplitude", "priority", "recovery", "run_studies", "save_studies", "split_study_name",
+           "stable_roots_near", "study_name", "transition_bracket"]

@@ -121,7 +121,8 @@ def test_a_study_that_fails_beside_others_lets_them_finish_and_is_named(runner, 
 
     monkeypatch.setitem(CLAIMS, "C7", dataclasses.replace(CLAIMS["C7"], study=failing))
     monkeypatch.setitem(CLAIMS, "C8", dataclasses.replace(CLAIMS["C8"], study=slow))
-    with pytest.raises(StudiesFailed, match=r"3 studies failed \(C7@.*\); the first: ValueError: no such point") as caught:
+    failure = r"3 studies failed \(C7@.*\); the first: ValueError: no such point"
+    with pytest.raises(StudiesFailed, match=failure) as caught:
         run_studies(runner, ["C7", "C8"], progress=False, at_once=8)
     assert sorted(name for name, _ in caught.value.failures) == sorted(
         study_name("C7", r) for r in READINGS if r != DEFAULT_READING)
