@@ -39,7 +39,7 @@ STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 # the compute time of each claim's study under one reading in the main job at the default
 # resolution (README: C6 ~370 s, C6r ~330 s, Fig. 1c ~300 s, C8 100-130 s, C3 ~100 s,
 # C4 ~75 s, C7 40-60 s, C5 20-30 s, then seconds), with Fig. 1c ahead of C6r: its
-# runs of the paper's drive (up to 85 s each) are the job's longest single tasks.
+# runs of the paper's drive (up to 82 s each) are the job's longest single tasks.
 COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "C8", "C3", "C4", "C7", "C5", "C2", "C1", "Fig1b")
 
 
