@@ -551,10 +551,11 @@ int python_slave_native_step(const PythonSlave* slave, double t, double h)
 
 /* The slave's Block outputs for a read whose value references are all in the record's
  * table: Block._observe's time within the grid step, one call of the observe kernel, and
- * Block._observables' arithmetic, so the same bits.  0 (values undefined) when the read
- * must go to the slave: a reference not in the table, no run started, a kernel that
- * raised, or a value that is not finite (the slave's read is then the one on record). */
-int python_slave_native_get_real(const PythonSlave* slave, const unsigned int vr[], size_t nvr, double values[])
+ * Block._observables' arithmetic, so the same bits (an Integer or Boolean output as the
+ * double its slot holds; the caller converts).  0 (values undefined) when the read must
+ * go to the slave: a reference not in the table, no run started, a kernel that raised,
+ * or a value that is not finite (the slave's read is then the one on record). */
+int python_slave_native_get(const PythonSlave* slave, const unsigned int vr[], size_t nvr, double values[])
 {
     NativeStep* n = (NativeStep*)slave->native;
     if (n == NULL || !n->ready || n->observe == NULL || n->obs == NULL || n->outputs == NULL) return 0;

@@ -38,9 +38,10 @@ int python_slave_do_step(const PythonSlave* slave, double t, double h, PythonSla
  * to python_slave_do_step (it then starts from the state this call left). */
 int python_slave_native_step(const PythonSlave* slave, double t, double h);
 
-/* Read Real outputs of the slave's block from its observation, without Python: 1 when
- * every value reference is one the record serves and the values are filled, 0 when the
- * read must go to the slave. */
-int python_slave_native_get_real(const PythonSlave* slave, const unsigned int vr[], size_t nvr, double values[]);
+/* Read outputs of the slave's block from its observation, without Python: 1 when every
+ * value reference is one the record serves and the values are filled (Integer and Boolean
+ * outputs as the doubles their observation slots hold), 0 when the read must go to the
+ * slave.  The caller checks the references' types first. */
+int python_slave_native_get(const PythonSlave* slave, const unsigned int vr[], size_t nvr, double values[]);
 
 #endif

@@ -25,11 +25,13 @@ GRID_TOLERANCE = 1e-6
 # request beyond it (e.g. a horizon of 1e9 at dt = 4e-4: 2.5e12 steps, hours) is refused
 # with its cost and the ways around it instead of holding the host.
 STEP_BUDGET_PER_CALL = 2**36
-# The Real outputs that are plain entries of the observation in every reading: a native
-# front end may read them without Python (vibroblock.native; _observables is the reference).
+# The outputs that are plain entries of the observation in every reading: a native front
+# end may read them without Python (vibroblock.native; _observables is the reference).
+# The Boolean contact and the Integer slip_count are stored as 0.0/1.0 and a whole count;
+# the front end converts them as _observables does (!= 0, truncation).
 OBSERVED_OUTPUTS = {"x": L.O_X, "friction_force": L.O_FRICTION, "normal_force": L.O_NORMAL,
                     "phi_integral": L.O_PHI, "penetration": L.O_PENETRATION, "work_input": L.O_WORK,
-                    "energy_dissipated": L.O_DISSIPATED}
+                    "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "slip_count": L.O_SLIPS}
 # ... and in the model's own reading, where the state is the point itself.
 OBSERVED_POINT = {"z": L.O_Z, "vx": L.O_VX, "vz": L.O_VZ, "surface_z": SURFACE_Z}
 
@@ -109,7 +111,7 @@ class Block:
         there), with ``time_tolerance`` the front end's match of a master's time to the
         block's.  The record takes over this block's time and arrays; a record already
         driving another block is simply re-pointed at this one.  ``output_refs`` (output
-        name -> value reference) lets the front end read those Real outputs too."""
+        name -> value reference) lets the front end read those outputs too."""
         record.time, record.time_tolerance = self.time, time_tolerance
         self._output_refs = dict(output_refs or {})
         for name in ("layout", "returned_ok", "observed_ok", "step_slot", "grid_tolerance"):

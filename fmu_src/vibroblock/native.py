@@ -17,11 +17,15 @@ says what went wrong.
 Reading outputs after each doStep is the other call a master makes all the time; through
 pythonfmu a read of five outputs is a Python call that builds the whole observation
 (about 7 us).  The record therefore also carries the observe kernel as a cfunc, the
-Block's observation array and a table of the Real outputs that are plain entries of
-that observation: (value reference, observation slot) pairs, or one of the two outputs
-computed from it (``SURFACE_Z``, ``ZERO``).  A front end asked for outputs that are all
-in the table fills them from one observe call, with the same arithmetic as
-``Block._observables``; any other read goes to the slave.
+Block's observation array and a table of the outputs that are plain entries of that
+observation: (value reference, observation slot) pairs, or one of the two outputs
+computed from it (``SURFACE_Z``, ``ZERO``).  pythonfmu numbers the variables of all
+types in one sequence, so one table serves fmi2GetReal, fmi2GetInteger and
+fmi2GetBoolean; the front end checks a reference's type against the model description
+before it looks in the table.  A front end asked for outputs that are all in the table
+fills them from one observe call, with the same arithmetic as ``Block._observables``
+(an Integer truncated, a Boolean true where the slot is not 0); any other read goes to
+the slave.
 
 The record is laid out as ``NativeStep`` in ``build/python_runtime.c``; ``LAYOUT``
 names the version both sides check.

@@ -99,22 +99,27 @@ def test_the_records_kernel_advances_as_advance_to(model, integrator, options):
 @pytest.mark.parametrize("model, integrator, options", CASES)
 @pytest.mark.parametrize("energy", [False, True])
 def test_the_records_observation_gives_the_outputs(model, integrator, options, energy):
-    """Read through the record at grid points and between them, every Real output the
-    table names has the bits of ``Block.outputs``.  It names them all in the model's own
+    """Read through the record at grid points and between them, every output the table
+    names has the bits of ``Block.outputs`` (the Boolean contact and the Integer
+    slip_count converted as the front end does).  It names them all in the model's own
     reading, except the energy residual with the energy balance on (a sum Python forms);
     in another reading (C in the tangent frame here) not the block's height and
     velocities nor the surface under it, which Python converts from the frame's state."""
     block, record = driven(model, integrator, options, energy, REFS)
     block.start()
     own_reading = "formulation" not in options
-    served = {name for name in REAL_OUTPUTS
+    served = {name for name in [*REAL_OUTPUTS, "contact", "slip_count"]
               if (own_reading or name not in ("z", "vx", "vz", "surface_z"))
               and not (energy and name == "energy_residual")}
+    convert = {"contact": lambda v: v != 0.0, "slip_count": int}
     normal_forces = []
     for t_end in (0.5, 0.7301, 2.0, 7.3105, 12.5):  # dt = 4e-4 (the default): two ends between grid points
         block.advance_to(t_end)
         outputs = block.outputs()
-        assert native_read(record) == {REFS[name]: outputs[name] for name in served}
+        read = native_read(record)
+        assert {vr: convert.get(name, float)(read[vr]) for name, vr in REFS.items() if vr in read} == {
+            REFS[name]: outputs[name] for name in served}
+        assert type(outputs["contact"]) is bool and type(outputs["slip_count"]) is int
         normal_forces.append(outputs["normal_force"])
     assert max(normal_forces) > 0.0  # some reads in contact
 
