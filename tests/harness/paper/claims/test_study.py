@@ -37,10 +37,13 @@ def test_corrugated_models_run_adaptive_at_low_omega_and_the_paper_s_scheme_abov
         assert run.integration == CORRUGATED_INTEGRATION
         assert {name: run.parameters[name] for name in CORRUGATED_TOLERANCES} == CORRUGATED_TOLERANCES
         limits = dict(CORRUGATED_INTEGRATION.switch)
-        assert set(limits) == {"omega", "V_d"}
-        at_limits = run.with_parameters(limits)
+        assert set(limits) == {"omega", "plate_speed", "V_d"}
+        # omega and V_d at their limits, the plate speed A omega just inside its own.
+        at_limits = run.with_parameters({"omega": limits["omega"], "V_d": limits["V_d"],
+                                         "A": 0.999 * limits["plate_speed"] / limits["omega"]})
         assert at_limits.fmu_values()["integrator"] == "adaptive"
-        for name, limit in limits.items():
-            assert at_limits.with_parameters({name: limit * 1.01}).fmu_values()["integrator"] == "symplectic_euler"
+        for name in ("omega", "V_d", "A"):  # A: beyond the plate-speed limit
+            beyond = at_limits.with_parameters({name: at_limits.parameters[name] * 1.01})
+            assert beyond.fmu_values()["integrator"] == "symplectic_euler", name
     # A study's own tolerance wins over the default one.
     assert runner.run("C", parameters={"rtol": 1e-9}).parameters["rtol"] == 1e-9
