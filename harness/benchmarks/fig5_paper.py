@@ -70,6 +70,10 @@ GRID_AMPLITUDES = np.geomspace(0.3, 300.0, 8)
 DT = 1.0  # adaptive's storage grid: no effect on accuracy or cost
 TARGET = 600.0  # seconds for the 8 x 8 diagram
 CHUNK_SECONDS = 1.0  # wall time aimed at per advance call
+# Longest advance call: a chunk grown while the block was held (periods jumped at ~1e8
+# tau_0 per second) must not carry on into a slip or a flank resolved at ~1 step per tau_0,
+# where it would meet the per-call step budget (16.7e6 steps) and fail with its work uncounted.
+CHUNK_MAX = 1e7
 
 
 def paper_parameters() -> dict:
@@ -110,7 +114,7 @@ def run_point(args):
         elapsed = time.perf_counter() - started
         if elapsed >= cap:
             break
-        chunk = DT * max(1.0, math.floor(chunk / DT))
+        chunk = DT * max(1.0, math.floor(min(chunk, CHUNK_MAX) / DT))
         before = time.perf_counter()
         try:
             block.advance_to(t + chunk)

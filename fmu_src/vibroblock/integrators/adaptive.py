@@ -574,27 +574,36 @@ def _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energ
 #   delta_{n+1} = M delta_n + r + n q,   delta_n = y_n - y_0,
 # with r = P(y_0, D_0) - y_0 from one resolved period (whose step sequence is recorded),
 # M = dP/dy and q = V_d T dP/dD from replays of that sequence on perturbed starts (finite
-# differences that share every step, so they carry no step-selection noise), and the
-# quadratures (phi, energies) summed along with the same linear model.  Ringing modes
-# that have not died are carried exactly by M^n (they are linear); K periods cost
-# log2(K) products of 11 x 11 matrices.
+# differences that share every step, so they carry no step-selection noise).  Ringing
+# modes that have not died are carried exactly by M^n (they are linear); K periods cost
+# log2(K) products of 11 x 11 matrices.  The quadratures (phi, energies) are quadratic
+# in the velocities: the linear model sums their per-period increments to first order
+# in delta, and as the state drifts (delta_n ~ n d) the true increment leaves it by
+# rho(n) ~ c n^2.  That second-order term is measured, not neglected: c from the period
+# the jump lands on, the sum corrected by c (K-1) K (2K-1) / 6.  Without it the jumps
+# along a paper-parameter stick shrank to a few hundred periods as the block crept off a
+# crest, bounded by phi alone (model C held at a crest, tangent frame, omega = 0.1,
+# A = A_c/3, rtol 1e-6: 3.2e6 plate periods in 1.1e7 steps; 1.0e6 with it).
 #
 # Error control.  The state a jump lands on is checked by replaying the same step
-# sequence from it: the increment of that period (state and phi) against the linear
-# model's prediction must stay within rtol/atol (error per period crossed), else the jump
-# is retaken shorter.  The replay is the next jump's resolved period, and a model that
-# predicted it well is kept for the next jump.  Events: each event value's minimum over
-# the resolved period (its margin) is watched; a jump may use up at most STROBE_MARGIN of
-# any margin at the rate the last jump showed, and a period whose replay meets an event,
-# or a jump allowed fewer than STROBE_MIN periods, hands back to resolved stepping, which
-# locates the switch on its own step.  (Envelope following, as for circuits driven by a
-# fast periodic source.)
+# sequence from it: the increment of that period against the linear model's prediction
+# must stay within rtol/atol (error per period crossed), else the jump is retaken
+# shorter.  phi is checked halfway: the period there is replayed too, and its residual
+# must be the c (K/2)^2 of the quadratic law within rtol of a period's increment -- a
+# ringing that the jump carries linearly breaks that law first.  The landing's replay is
+# the next jump's resolved period, and a model that passed is kept for the next jump
+# (its error, should the state have drifted too far for it, is the next check's).
+# Events: each event value's minimum over the resolved periods (its margin) is watched; a
+# jump may use up at most STROBE_MARGIN of any margin at the rate the last jump showed,
+# and a period whose replay (halfway or at the landing) meets an event, or a jump allowed
+# fewer than STROBE_MIN periods, hands back to resolved stepping, which locates the switch
+# on its own step.  (Envelope following, as for circuits driven by a fast periodic source.)
 STROBE_MIN = 4          # fewest periods a jump spans
 STROBE_FIRST = 8        # the first jump of a session, before a margin's rate is known
 STROBE_GROW = 8.0       # largest growth of the jump from one jump to the next
 STROBE_MARGIN = 0.5     # largest fraction of an event's margin one jump may use up
 STROBE_STEPS = 2048     # steps the recorded period may hold
-STROBE_KEEP = 0.5       # a model whose landing was checked within this fraction of the tolerance is kept
+STROBE_KEEP = 1.0       # a model whose jump passed within this fraction of the tolerance is kept
 STROBE_WAIT = 2         # periods of resolved stepping before the next try, doubled after each failed try
 STROBE_WAIT_MAX = 1024
 STROBE_EPS = 1e-6       # relative perturbation of the state's finite differences
@@ -736,6 +745,12 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
     sq = np.zeros((NA, NA))
     vec = np.zeros(NA)
     tmp = np.zeros(NA)
+    vec_mid = np.zeros(NA)
+    moved_mid = np.zeros(NV)
+    check_mid = np.zeros(NV)
+    margins_mid = np.zeros(3)
+    scale_mid = np.zeros(NS)
+    curvature = np.zeros(4)
     for i in range(4):
         dq[i] = 0.0
     for i in range(NS):
@@ -836,25 +851,53 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
                 steps = _period(kind, regime, moved, t_abs + count * period, 0.0, drv, cnt, n0, u + count * period,
                                 period, cap, h_first, prm, track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0,
                                 jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx)
+            if steps > 0:
+                # The period halfway, replayed from the model's state there (quadratures' check).
+                mid = count // 2
+                for i in range(NA):
+                    vec_mid[i] = 0.0
+                    for j in range(NA):
+                        work[i, j] = g[i, j]
+                vec_mid[NV] = 1.0
+                _affine_power(work, mid, vec_mid, sq, tmp)
+                for i in range(NS):
+                    moved_mid[i] = y0[i] + vec_mid[i]
+                for i in range(NS, NV):
+                    moved_mid[i] = 0.0
+                steps = _period(kind, regime, moved_mid, t_abs + mid * period, 0.0, drv, cnt, n0, u + mid * period,
+                                period, cap, h_first, prm, track_energy, hs, n_hs, check_mid, margins_mid, scale_mid,
+                                tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx)
             err = math.inf
             if steps > 0:
                 # The landed period's increment against the model's, r + (M - I) delta_K + K q,
                 # within the tolerances: error per period crossed, as a resolved period's steps
                 # are held to theirs (the rounding of the plate's phase and of the positions sets
-                # a floor of ~1e-12 per period that no jump length can get under).  phi's
-                # increment too, relative to a period's: it is quadratic in the velocities, so a
-                # ringing that the jump carries linearly shows there first.
+                # a floor of ~1e-12 per period that no jump length can get under).
                 err = 0.0
-                for i in range(NS + 1):
-                    predicted = (base[i] - y0[i] if i < NS else base[i]) + cols[NS, i] * count
+                for i in range(NS):
+                    predicted = base[i] - y0[i] + cols[NS, i] * count
                     for j in range(NS):
                         predicted += (cols[j, i] - (1.0 if i == j else 0.0)) * vec[j]
-                    if i < NS:
-                        weight = atol + rtol * max(abs(y0[i]), abs(moved[i]), scale[i])
-                        e = (check[i] - moved[i] - predicted) / weight
-                    else:
-                        e = (check[i] - predicted) / (rtol * (abs(base[i]) + vd * vd * period) + 1e-300)
+                    weight = atol + rtol * max(abs(y0[i]), abs(moved[i]), scale[i])
+                    e = (check[i] - moved[i] - predicted) / weight
                     err += e * e
+                # The quadratures are quadratic in the velocities, so their per-period
+                # increment leaves the linear model by rho(n) ~ c n^2 as the state drifts
+                # (exactly so for a drift linear in n); c from the landed period, the sum
+                # corrected by c (K-1) K (2K-1) / 6.  The halfway period must show the same
+                # c: phi's residual there against c (K/2)^2, relative to a period's
+                # increment -- a ringing that the jump carries linearly breaks that first.
+                for i in range(NS, NV):
+                    at_end = base[i] + cols[NS, i] * count
+                    at_mid = base[i] + cols[NS, i] * mid
+                    for j in range(NS):
+                        at_end += cols[j, i] * vec[j]
+                        at_mid += cols[j, i] * vec_mid[j]
+                    curvature[i - NS] = (check[i] - at_end) / (float(count) * count)
+                    if i == NS:
+                        e = ((check_mid[i] - at_mid) - curvature[0] * float(mid) * mid) / (
+                            rtol * (abs(base[i]) + vd * vd * period) + 1e-300)
+                        err += e * e
                 err = math.sqrt(err / (NS + 1))
             if err <= 1.0 or not model_fresh:
                 break
@@ -870,8 +913,9 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
         for i in range(NS):
             y0[i] = moved[i]
             v[i] = moved[i]
+        kk = float(count)
         for i in range(4):
-            dq[i] += vec[NS + i]
+            dq[i] += vec[NS + i] + curvature[i] * (kk - 1.0) * kk * (2.0 * kk - 1.0) / 6.0
         for i in range(NV):
             base[i] = check[i]
         for e in range(n_events):
@@ -981,13 +1025,13 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             rejected += tally[1]
             jacobians += tally[2]
             jumped += tally[3]
+            fresh = False  # the try's replays used f0, jac and the stages as scratch
             if u_jumped > u:
                 u = u_jumped
                 phi, phi_c = kahan_add(phi, phi_c, dq[0])
                 work_sum += dq[1]
                 dissipated += dq[2]
                 e_normal += dq[3]
-                fresh = False
                 strobe_wait = STROBE_WAIT
                 if not math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4]):
                     status = NON_FINITE

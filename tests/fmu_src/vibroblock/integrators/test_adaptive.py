@@ -284,6 +284,56 @@ def test_stroboscopic_jumps_agree_with_every_period_resolved(model):
     assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-6 * ref["phi_integral"]
 
 
+def test_jumps_tried_and_refused_leave_the_run_as_it_was():
+    """Model C at the paper's parameters held at a crest from a stretched drive spring: the
+    friction spring rings all along, no jump passes its check, and the tries (replays of
+    the plate's period) cost steps but change nothing: the run is bit for bit the one with
+    jumps off.  (A try's replays use the stepper's work arrays, so the step after a refused
+    try starts from a fresh rate.)"""
+    runs = {}
+    for max_jump in (0.0, 1e12):
+        block = Block("C", "adaptive", initial_state=2, A=3.0, omega=0.316, x_start=CREST_X, dt=1.0,
+                      max_jump=max_jump, formulation=1, rtol=1e-6, atol=1e-8)
+        block.start()
+        block.advance_to(2e4)
+        runs[max_jump] = block
+    tried, off = runs[1e12], runs[0.0]
+    assert tried.counters["periods_jumped"] == 0
+    assert tried.counters["accepted"] > off.counters["accepted"]  # the tries were made
+    assert tried.outputs() == off.outputs()
+
+
+def test_jumps_stay_long_while_the_slow_variables_drift():
+    """Model C held at a crest while the drive's pull grows a hundred times faster than at
+    the paper's k_d (1e6 tau_0, 1.6e5 plate periods: the tangential spring's stretch moves
+    by 0.1, the block by 0.35 delta_0 along the corrugation).  phi's per-period increment
+    leaves the jumps' linear model quadratically in the drift; carried to second order, the
+    jumps still span hundreds of periods, and the run agrees with every period resolved."""
+    from vibroblock import defaults, detachment_amplitude
+    p = defaults("C")
+    omega = 1.0
+    amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
+    runs = {}
+    for max_jump in (0.0, 1e12):
+        block = Block("C", "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=CREST_X, dt=1.0,
+                      k_d=100 * p["k_d"], formulation=1, rtol=1e-6, atol=1e-8, max_jump=max_jump)
+        t0 = CREST_X / p["V_d"]
+        block.start(t0)
+        for i in range(1, 11):  # calls within the per-call step budget of the resolved run
+            block.advance_to(t0 + 1e5 * i)
+        runs[max_jump] = block
+    resolved, jumped = runs[0.0], runs[1e12]
+    ref, out = resolved.outputs(), jumped.outputs()
+    assert jumped.counters["periods_jumped"] > 0.99 * 1e6 / (2 * math.pi / omega)
+    # Before the quadratures' second order: 1.5e6 steps (resolved: 2.5e6); now 3.9e5.
+    assert jumped.counters["accepted"] < resolved.counters["accepted"] / 5
+    assert out["slip_count"] == ref["slip_count"] == 0 and abs(ref["friction_force"]) > 0.09
+    assert abs(out["x"] - ref["x"]) <= 1e-5
+    assert abs(out["friction_force"] - ref["friction_force"]) <= 1e-7
+    assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-5 * ref["phi_integral"]
+    assert abs(out["energy_dissipated"] - ref["energy_dissipated"]) <= 1e-6 * ref["energy_dissipated"]
+
+
 def test_stroboscopic_jumps_stop_before_the_slip_they_would_cross():
     """A jump never crosses a switch: the slip that ends a vibrated stick of model A comes at
     the time every period resolved gives (event_driven as the independent reference)."""
