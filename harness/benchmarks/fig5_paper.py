@@ -42,11 +42,12 @@ is divided by the workers.  The verdict compares that with 10 minutes.
 
 No diagram is drawn and no flag offers one: measured on the 2-core development machine
 (README, "Choosing speed or accuracy"), with adaptive's explicit pair and its stroboscopic
-jumps across the held block's plate periods, the 8 x 8 diagram extrapolates to 43 min on
-2 cores at ``--rtol 1e-6`` and 6.9 h at the default 1e-8 in the tangent frame, 5.0 h and
-1.05 days in fixed axes (where the held orbit is not periodic and the jumps are refused).
-A held block's jumps shrink along a stick (README), so a cap that covers only the start
-of a stick extrapolates low.  Measured figures only; nothing here is a timed test.
+jumps across the held block's plate periods (quadratures to second order in the drift),
+the 8 x 8 diagram extrapolates to 18 min on 2 cores at ``--rtol 1e-6`` and 3.3 h at the
+default 1e-8 in the tangent frame, 5.0 h and 18 h in fixed axes (where the held orbit is
+not periodic and the jumps are refused); the sliding points, resolved hop by hop, are
+most of it.  At rtol 1e-8 the jumps shrink along a stick, so a cap that covers only the
+start of a stick extrapolates low.  Measured figures only; nothing here is a timed test.
 """
 from __future__ import annotations
 
