@@ -720,6 +720,22 @@ def _affine_power(g, power, vec, sq, tmp):
                 g[i, j] = sq[i, j]
 
 
+@njit(inline="always")
+def _apply_periods(g, periods, y0, vec, moved, work, sq, tmp):
+    """The model's K periods from y0: vec <- g^K (0, 0, 1, 0) (state change, quadratures'
+    sums, 1, K) and moved <- the state there (quadratures 0); work holds g's powers."""
+    for i in range(NA):
+        vec[i] = 0.0
+        for j in range(NA):
+            work[i, j] = g[i, j]
+    vec[NV] = 1.0
+    _affine_power(work, periods, vec, sq, tmp)
+    for i in range(NS):
+        moved[i] = y0[i] + vec[i]
+    for i in range(NS, NV):
+        moved[i] = 0.0
+
+
 @njit(cache=True)
 def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h_first, prm, track_energy, dq,
                   tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx):
@@ -835,16 +851,7 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
             g[NV, NV] = 1.0
             g[NV + 1, NV] = 1.0
             g[NV + 1, NV + 1] = 1.0
-            for i in range(NA):
-                vec[i] = 0.0
-                for j in range(NA):
-                    work[i, j] = g[i, j]
-            vec[NV] = 1.0
-            _affine_power(work, count, vec, sq, tmp)
-            for i in range(NS):
-                moved[i] = y0[i] + vec[i]
-            for i in range(NS, NV):
-                moved[i] = 0.0
+            _apply_periods(g, count, y0, vec, moved, work, sq, tmp)
             ok = math.isfinite(vec[0] + vec[1] + vec[2] + vec[3] + vec[4] + vec[5])
             steps = -1
             if ok:
@@ -854,16 +861,7 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
             if steps > 0:
                 # The period halfway, replayed from the model's state there (quadratures' check).
                 mid = count // 2
-                for i in range(NA):
-                    vec_mid[i] = 0.0
-                    for j in range(NA):
-                        work[i, j] = g[i, j]
-                vec_mid[NV] = 1.0
-                _affine_power(work, mid, vec_mid, sq, tmp)
-                for i in range(NS):
-                    moved_mid[i] = y0[i] + vec_mid[i]
-                for i in range(NS, NV):
-                    moved_mid[i] = 0.0
+                _apply_periods(g, mid, y0, vec_mid, moved_mid, work, sq, tmp)
                 steps = _period(kind, regime, moved_mid, t_abs + mid * period, 0.0, drv, cnt, n0, u + mid * period,
                                 period, cap, h_first, prm, track_energy, hs, n_hs, check_mid, margins_mid, scale_mid,
                                 tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx)
