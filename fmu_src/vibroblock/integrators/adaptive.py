@@ -879,12 +879,8 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
                     weight = atol + rtol * max(abs(y0[i]), abs(moved[i]), scale[i])
                     e = (check[i] - moved[i] - predicted) / weight
                     err += e * e
-                # The quadratures are quadratic in the velocities, so their per-period
-                # increment leaves the linear model by rho(n) ~ c n^2 as the state drifts
-                # (exactly so for a drift linear in n); c from the landed period, the sum
-                # corrected by c (K-1) K (2K-1) / 6.  The halfway period must show the same
-                # c: phi's residual there against c (K/2)^2, relative to a period's
-                # increment -- a ringing that the jump carries linearly breaks that first.
+                # The quadratures' second order (the section's comment): c from the landed
+                # period; phi's residual halfway against c (K/2)^2, to rtol of a period's.
                 for i in range(NS, NV):
                     at_end = base[i] + cols[NS, i] * count
                     at_mid = base[i] + cols[NS, i] * mid

@@ -249,18 +249,19 @@ def test_energy_balance_closes_in_the_tangent_frame(model, coulomb_normal):
 CREST_X = 0.5 * math.pi / 0.02  # a crest of the paper's corrugation (slope 0)
 
 
-def _vibrated_stick(model, max_jump, horizon, **keywords):
+def _vibrated_stick(model, max_jump, horizon, omega=0.316, calls=1, **keywords):
     """Model B or C at the paper's parameters held at a crest on a plate vibrated at a third
-    of the detachment onset (no switch within the horizon), from the steady orbit."""
+    of the detachment onset (no switch within the horizon), from the steady orbit, advanced
+    in ``calls`` equal calls."""
     from vibroblock import defaults, detachment_amplitude
     p = defaults(model)
-    omega = 0.316
     amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
     block = Block(model, "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=CREST_X, dt=1.0,
                   max_jump=max_jump, **keywords)
     t0 = CREST_X / p["V_d"]
     block.start(t0)
-    block.advance_to(t0 + horizon)
+    for call in range(1, calls + 1):
+        block.advance_to(t0 + horizon * call / calls)
     return block
 
 
@@ -309,20 +310,11 @@ def test_jumps_stay_long_while_the_slow_variables_drift():
     by 0.1, the block by 0.35 delta_0 along the corrugation).  phi's per-period increment
     leaves the jumps' linear model quadratically in the drift; carried to second order, the
     jumps still span hundreds of periods, and the run agrees with every period resolved."""
-    from vibroblock import defaults, detachment_amplitude
-    p = defaults("C")
+    from vibroblock import defaults
     omega = 1.0
-    amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
-    runs = {}
-    for max_jump in (0.0, 1e12):
-        block = Block("C", "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=CREST_X, dt=1.0,
-                      k_d=100 * p["k_d"], formulation=1, rtol=1e-6, atol=1e-8, max_jump=max_jump)
-        t0 = CREST_X / p["V_d"]
-        block.start(t0)
-        for i in range(1, 11):  # calls within the per-call step budget of the resolved run
-            block.advance_to(t0 + 1e5 * i)
-        runs[max_jump] = block
-    resolved, jumped = runs[0.0], runs[1e12]
+    # Ten calls keep the resolved run within the per-call step budget.
+    resolved, jumped = (_vibrated_stick("C", max_jump, 1e6, omega=omega, calls=10, k_d=100 * defaults("C")["k_d"],
+                                        formulation=1, rtol=1e-6, atol=1e-8) for max_jump in (0.0, 1e12))
     ref, out = resolved.outputs(), jumped.outputs()
     assert jumped.counters["periods_jumped"] > 0.99 * 1e6 / (2 * math.pi / omega)
     # Before the quadratures' second order: 1.5e6 steps (resolved: 2.5e6); now 3.9e5.
