@@ -606,6 +606,11 @@ STROBE_STEPS = 2048     # steps the recorded period may hold
 STROBE_KEEP = 1.0       # a model whose jump passed within this fraction of the tolerance is kept
 STROBE_WAIT = 2         # periods of resolved stepping before the next try, doubled after each failed try
 STROBE_WAIT_MAX = 1024
+# Fewest plate periods left in a call for a try: a try replays ~15 periods (the recorded
+# one, two per state column and for the pull, the landing and the halfway check) for a
+# first jump of STROBE_FIRST, so it pays only where the longer jumps that reuse its model
+# have room; a call that cannot hold them resolves its periods (as with jumps off).
+STROBE_PAYBACK = 32
 STROBE_EPS = 1e-6       # relative perturbation of the state's finite differences
 STROBE_PULL = 1e-4      # change of the drive's pull (k_d times its far end's shift) of the drive's difference
 NA = NV + 2             # affine model on (delta, quadratures, 1, n)
@@ -883,15 +888,15 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
                 # period; phi's residual halfway against c (K/2)^2, to rtol of a period's.
                 for i in range(NS, NV):
                     at_end = base[i] + cols[NS, i] * count
-                    at_mid = base[i] + cols[NS, i] * mid
                     for j in range(NS):
                         at_end += cols[j, i] * vec[j]
-                        at_mid += cols[j, i] * vec_mid[j]
                     curvature[i - NS] = (check[i] - at_end) / (float(count) * count)
-                    if i == NS:
-                        e = ((check_mid[i] - at_mid) - curvature[0] * float(mid) * mid) / (
-                            rtol * (abs(base[i]) + vd * vd * period) + 1e-300)
-                        err += e * e
+                at_mid = base[NS] + cols[NS, NS] * mid
+                for j in range(NS):
+                    at_mid += cols[j, NS] * vec_mid[j]
+                e = ((check_mid[NS] - at_mid) - curvature[0] * float(mid) * mid) / (
+                    rtol * (abs(base[NS]) + vd * vd * period) + 1e-300)
+                err += e * e
                 err = math.sqrt(err / (NS + 1))
             if err <= 1.0 or not model_fresh:
                 break
@@ -1010,7 +1015,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             explicit = next_explicit
             fresh = False
             stagnant = 0
-        if period > 0.0 and regime == LOADED and u >= strobe_next and u_end - u >= (STROBE_MIN + 2) * period:
+        if period > 0.0 and regime == LOADED and u >= strobe_next and u_end - u >= STROBE_PAYBACK * period:
             tally[:] = 0
             u_jumped = _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h, prm,
                                      track_energy, dq, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe,
