@@ -606,11 +606,16 @@ STROBE_STEPS = 2048     # steps the recorded period may hold
 STROBE_KEEP = 1.0       # a model whose jump passed within this fraction of the tolerance is kept
 STROBE_WAIT = 2         # periods of resolved stepping before the next try, doubled after each failed try
 STROBE_WAIT_MAX = 1024
-# Fewest plate periods left in a call for a try: a try replays ~15 periods (the recorded
+# What a try costs and when it may pay.  A try replays ~STROBE_TRY periods (the recorded
 # one, two per state column and for the pull, the landing and the halfway check) for a
 # first jump of STROBE_FIRST, so it pays only where the longer jumps that reuse its model
-# have room; a call that cannot hold them resolves its periods (as with jumps off).
+# have room: a call tries only while STROBE_PAYBACK periods remain, and only while its
+# refused tries, this one counted, stay within STROBE_SHARE of the periods it has advanced
+# (the first try after 32 periods).  So a run whose tries are all refused (a ringing
+# spring) pays at most that share, and a short call is resolved as with jumps off.
+STROBE_TRY = 16
 STROBE_PAYBACK = 32
+STROBE_SHARE = 0.5
 STROBE_EPS = 1e-6       # relative perturbation of the state's finite differences
 STROBE_PULL = 1e-4      # change of the drive's pull (k_d times its far end's shift) of the drive's difference
 NA = NV + 2             # affine model on (delta, quadratures, 1, n)
@@ -991,6 +996,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         period = 2.0 * math.pi / drv[D_OMEGA]
     strobe_next = 0.0
     strobe_wait = STROBE_WAIT
+    refused = 0  # periods replayed by this call's refused tries (STROBE_TRY each)
     dq = np.zeros(4)
     tally = np.zeros(4, dtype=np.int64)
     rtol = prm[P_RTOL]
@@ -1015,7 +1021,8 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             explicit = next_explicit
             fresh = False
             stagnant = 0
-        if period > 0.0 and regime == LOADED and u >= strobe_next and u_end - u >= STROBE_PAYBACK * period:
+        if (period > 0.0 and regime == LOADED and u >= strobe_next and u_end - u >= STROBE_PAYBACK * period
+                and STROBE_SHARE * u >= (refused + STROBE_TRY) * period):
             tally[:] = 0
             u_jumped = _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h, prm,
                                      track_energy, dq, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe,
@@ -1037,6 +1044,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                     break
             else:
                 strobe_wait = min(2 * strobe_wait, STROBE_WAIT_MAX)
+                refused += STROBE_TRY
             strobe_next = u + strobe_wait * period
             continue
         if not fresh:
