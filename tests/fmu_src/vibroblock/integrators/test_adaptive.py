@@ -90,6 +90,48 @@ def test_the_explicit_pair_steps_motion_that_is_not_stiff_and_rodas4_motion_that
     assert error(block.outputs(), ref) < 1e-6
 
 
+@pytest.mark.parametrize("model, formulation", [("A", 0), ("B", 0), ("C", 0), ("C", 1)])
+def test_a_flight_above_the_plates_reach_steps_past_the_cap_and_lands_where_the_reference_does(model, formulation):
+    """Launched from a crest by a plate at A omega^2 = 12.8 g, the block flies 11-20 plate
+    periods, most of them above the plate's highest point: steps past the cap (1/16 of a
+    period) there, then the landing, located against the plate's motion, and the state
+    after it as the reference's."""
+    parameters = dict(SCALED, A=20.0, omega=0.8)
+    readings = {} if model == "A" else {"formulation": formulation}
+    x_start = 0.0 if model == "A" else math.pi / 0.04  # a crest of the paper's corrugation
+    ref = reference.simulate(model, parameters, 250.0, solver=Solver.reference(1e-12), initial=2, x_start=x_start,
+                             **readings)
+    switches = [(t, kind) for t, kind in ref.event_log if kind in ("contact", "detach")]
+    (launch, first), (landing, second) = switches[:2]
+    assert (first, second) == ("detach", "contact")
+    cap = 2.0 * math.pi / parameters["omega"] / 16.0
+    assert landing - launch > 160.0 * cap  # > 10 periods: > 160 steps at the cap
+    # Steps in the flight where the error control allows long ones (rtol 1e-6)...
+    block = Block(model, "adaptive", dt=1e-2, initial_state=2, x_start=x_start, rtol=1e-6, atol=1e-8, **parameters,
+                  **readings)
+    block.start()
+    block.advance_to(launch + 1.0)
+    before = block.counters["accepted"] + block.counters["rejected"]
+    block.advance_to(landing - 1.0)
+    assert not block.outputs()["contact"]
+    in_flight = block.counters["accepted"] + block.counters["rejected"] - before
+    assert in_flight < 0.5 * (landing - 2.0 - launch) / cap
+    # ... and the landing at the tight tolerance: the state 2 tau_0 after it (violent,
+    # |vz| up to ~1e3) to 1e-9 of each component's size.
+    after = landing + 2.0
+    ref_after = reference.simulate(model, parameters, after, solver=Solver.reference(1e-12), initial=2,
+                                   x_start=x_start, **readings)
+    block = Block(model, "adaptive", dt=1e-2, initial_state=2, x_start=x_start, **TIGHT, **parameters, **readings)
+    block.start()
+    block.advance_to(after)
+    out = block.outputs()
+    for name in ("x", "z", "vx", "vz"):
+        assert abs(out[name] - ref_after.final(name)) < 1e-9 * max(1.0, abs(ref_after.final(name))), name
+    assert abs(out["phi_integral"] / ref_after.final("phi") - 1.0) < 1e-9
+    assert out["contact"] == bool(ref_after["contact"][-1])
+    assert out["slip_count"] == ref_after.slips
+
+
 @pytest.mark.parametrize("name", ["stick-slip", "sub-threshold", "bouncing"])
 def test_model_a_agrees_with_event_driven_to_1e_8(name):
     parameters, horizon, initial, x_start = scenario("A", name)
