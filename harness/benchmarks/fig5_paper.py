@@ -111,7 +111,7 @@ def run_point(args):
     t, chunk = t0, 16.0 * 2.0 * math.pi / omega
     error = ""
     while t < end and time.perf_counter() - started < cap:
-        target = min(t + DT * max(1.0, math.floor(min(chunk, CHUNK_MAX) / DT)), end)
+        target = min(t + DT * max(1.0, math.floor(chunk / DT)), end)
         if t < window_start:
             target = min(target, window_start)
         before = time.perf_counter()
@@ -125,7 +125,9 @@ def run_point(args):
         if t == window_start:
             phi_start, x_start = block.output("phi_integral"), block.output("x")
         remaining = cap - (time.perf_counter() - started)
-        chunk *= min(4.0, max(0.25, min(CHUNK_SECONDS, max(remaining, 0.05)) / took))
+        # Kept within CHUNK_MAX: a chunk grown unbounded while the jumps ran would stay at
+        # CHUNK_MAX for many calls after the motion turned expensive.
+        chunk = min(chunk * min(4.0, max(0.25, min(CHUNK_SECONDS, max(remaining, 0.05)) / took)), CHUNK_MAX)
     wall, cpu = time.perf_counter() - started, time.process_time() - cpu_started
     finished = t >= end and not error
     window = end - window_start

@@ -213,8 +213,13 @@ STIFF_HOLD = 32
 # --------------------------------------------------------------------------- physics
 @njit(inline="always")
 def _plate(drv, cnt, n0, u):
-    """Plate height and velocity at local time u after grid step n0."""
-    phase = drv[D_PHASE] + drv[D_OMEGA] * (drv[D_DT] * (n0 - cnt[C_PHASE_STEP]) + u)
+    """Plate height and velocity at local time u after grid step n0.  The phase at the
+    call's start is reduced modulo 2 pi before the local part is added: at t ~ 1e9 the
+    sum omega (t + u) would round to ~1e-7 rad, a noise from one local time to the next
+    that puts the plate ~1e-8 off between replays of a period (the stroboscopic jumps'
+    check refused every jump there) -- reduced, the rounding is a constant of the call."""
+    start = np.fmod(drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n0 - cnt[C_PHASE_STEP]), 2.0 * math.pi)
+    phase = start + drv[D_OMEGA] * u
     tau = (drv[D_T0] - drv[D_EXT_T]) + n0 * drv[D_DT] + u
     return plate_motion(drv[D_AMP], drv[D_OMEGA], math.sin(phase), math.cos(phase), drv[D_EXT_Z], drv[D_EXT_V],
                         drv[D_EXT_A], tau)

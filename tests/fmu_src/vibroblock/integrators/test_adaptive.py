@@ -291,16 +291,16 @@ def test_energy_balance_closes_in_the_tangent_frame(model, coulomb_normal):
 CREST_X = 0.5 * math.pi / 0.02  # a crest of the paper's corrugation (slope 0)
 
 
-def _vibrated_stick(model, max_jump, horizon, omega=0.316, calls=1, **keywords):
-    """Model B or C at the paper's parameters held at a crest on a plate vibrated at a third
-    of the detachment onset (no switch within the horizon), from the steady orbit, advanced
-    in ``calls`` equal calls."""
+def _vibrated_stick(model, max_jump, horizon, omega=0.316, calls=1, x_start=CREST_X, **keywords):
+    """Model B or C at the paper's parameters held at a crest (``x_start``) on a plate vibrated
+    at a third of the detachment onset (no switch within the horizon), from the steady
+    orbit, advanced in ``calls`` equal calls from the time the drive spring is relaxed."""
     from vibroblock import defaults, detachment_amplitude
     p = defaults(model)
     amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
-    block = Block(model, "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=CREST_X, dt=1.0,
+    block = Block(model, "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=x_start, dt=1.0,
                   max_jump=max_jump, **keywords)
-    t0 = CREST_X / p["V_d"]
+    t0 = x_start / p["V_d"]
     block.start(t0)
     for call in range(1, calls + 1):
         block.advance_to(t0 + horizon * call / calls)
@@ -324,6 +324,26 @@ def test_stroboscopic_jumps_agree_with_every_period_resolved(model):
     assert abs(out["x"] - ref["x"]) <= 1e-8 * abs(ref["x"]) + 1e-6
     assert abs(out["friction_force"] - ref["friction_force"]) <= 1e-9
     assert abs(out["vx"] - ref["vx"]) <= 1e-9 and abs(out["vz"] - ref["vz"]) <= 1e-8
+    assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-6 * ref["phi_integral"]
+
+
+def test_jumps_hold_two_billion_tau_0_after_the_time_origin():
+    """The same held stick started at t ~ 2e9 (a crest ~4e5 delta_0 down the corrugation, where
+    the drive spring is relaxed then): the plate's phase is reduced at each call's start,
+    so its rounding is a constant of the call, not a ~1e-8 noise between replays of a period
+    that the jumps' check would refuse (at 2e9 the sum omega (t + u) rounds to ~1e-7 rad).
+    The jumps cross as many periods as near t = 0 and agree with every period resolved."""
+    from vibroblock import defaults
+    horizon = 2e4
+    wavelength = 2.0 * math.pi / 0.02
+    crest = CREST_X + wavelength * round(2e9 * defaults("C")["V_d"] / wavelength)
+    near, far = (_vibrated_stick("C", 1e12, horizon, formulation=1, x_start=x) for x in (CREST_X, crest))
+    resolved = _vibrated_stick("C", 0.0, horizon, formulation=1, x_start=crest)
+    assert near.counters["periods_jumped"] > 900
+    assert far.counters["periods_jumped"] >= 0.9 * near.counters["periods_jumped"]
+    ref, out = resolved.outputs(), far.outputs()
+    assert abs(out["x"] - ref["x"]) <= 1e-8 * abs(ref["x"]) + 1e-6
+    assert abs(out["friction_force"] - ref["friction_force"]) <= 1e-8
     assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-6 * ref["phi_integral"]
 
 
