@@ -183,6 +183,7 @@ DENSE = np.array([
     [-0.6762803392801253, 6.087714651680015, 16.43084320892478, 24.76722511418386, -6.594389125716872]])
 
 EPS = 2.220446049250313e-16
+TWO_PI = 2.0 * math.pi
 JAC_STEP = 1e-5  # relative increment of the central differences (~eps^(1/3))
 
 # DOP853 (Dormand & Prince's explicit pair of order 8 with error estimators of orders 5
@@ -218,7 +219,8 @@ def _plate(drv, cnt, n0, u):
     sum omega (t + u) would round to ~1e-7 rad, a noise from one local time to the next
     that puts the plate ~1e-8 off between replays of a period (the stroboscopic jumps'
     check refused every jump there) -- reduced, the rounding is a constant of the call."""
-    start = np.fmod(drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n0 - cnt[C_PHASE_STEP]), 2.0 * math.pi)
+    start = drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n0 - cnt[C_PHASE_STEP])
+    start -= TWO_PI * math.floor(start / TWO_PI)  # (np.fmod costs ~1.5x a step here)
     phase = start + drv[D_OMEGA] * u
     tau = (drv[D_T0] - drv[D_EXT_T]) + n0 * drv[D_DT] + u
     return plate_motion(drv[D_AMP], drv[D_OMEGA], math.sin(phase), math.cos(phase), drv[D_EXT_Z], drv[D_EXT_V],
