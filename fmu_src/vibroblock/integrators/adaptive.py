@@ -138,6 +138,9 @@ CASCADE_GAP = 1e-9
 MAX_STEPS = 1 << 24
 # Events in a row without the time moving by more than EVENT_TOL before the run stops.
 MAX_IMMEDIATE = 64
+# A call moves the plate's clock (``_clock``) to its local time at least every
+# REBASE_CYCLES plate periods, so omega u stays below ~400 rad (rounding ~6e-14 rad).
+REBASE_CYCLES = 64
 # Step-size control.
 SAFETY, GROW, SHRINK = 0.9, 6.0, 0.2
 # Leaps across the error estimate's hump: a lightly damped mode (the friction spring
@@ -213,18 +216,36 @@ STIFF_HOLD = 32
 
 # --------------------------------------------------------------------------- physics
 @njit(inline="always")
-def _plate(drv, cnt, n0, u):
-    """Plate height and velocity at local time u after grid step n0.  The phase at the
-    call's start is reduced modulo 2 pi before the local part is added: at t ~ 1e9 the
-    sum omega (t + u) would round to ~1e-7 rad, a noise from one local time to the next
-    that puts the plate ~1e-8 off between replays of a period (the stroboscopic jumps'
-    check refused every jump there) -- reduced, the rounding is a constant of the call."""
-    start = drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n0 - cnt[C_PHASE_STEP])
-    start -= TWO_PI * math.floor(start / TWO_PI)  # (np.fmod costs ~1.5x a step here)
-    phase = start + drv[D_OMEGA] * u
-    tau = (drv[D_T0] - drv[D_EXT_T]) + n0 * drv[D_DT] + u
+def _clock(drv, cnt, n0):
+    """The plate's clock at grid step n0: (its phase reduced modulo 2 pi, the external
+    input's time).  A call reads the plate from local times u after its clock's origin,
+    phase + omega u: reduced once, the sum rounds to ~1e-16 of omega u, where omega (t + u)
+    at t ~ 1e9 would round to ~1e-7 rad and put the plate ~1e-8 off between replays of a
+    period (the stroboscopic jumps' check refused every jump there)."""
+    phase = drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n0 - cnt[C_PHASE_STEP])
+    clk = np.empty(2)
+    clk[0] = phase - TWO_PI * math.floor(phase / TWO_PI)
+    clk[1] = (drv[D_T0] - drv[D_EXT_T]) + n0 * drv[D_DT]
+    return clk
+
+
+@njit(inline="always")
+def _advance_clock(drv, clk, du, whole_periods):
+    """Move the clock's origin by du: its phase by omega du (reduced), or not at all when
+    du spans whole plate periods (a stroboscopic jump: the plate is where it was, exactly,
+    so that the periods replayed after the jump see the same plate as the one recorded)."""
+    if not whole_periods:
+        phase = clk[0] + drv[D_OMEGA] * du
+        clk[0] = phase - TWO_PI * math.floor(phase / TWO_PI)
+    clk[1] += du
+
+
+@njit(inline="always")
+def _plate(drv, clk, u):
+    """Plate height and velocity at local time u after the clock's origin (``_clock``)."""
+    phase = clk[0] + drv[D_OMEGA] * u
     return plate_motion(drv[D_AMP], drv[D_OMEGA], math.sin(phase), math.cos(phase), drv[D_EXT_Z], drv[D_EXT_V],
-                        drv[D_EXT_A], tau)
+                        drv[D_EXT_A], clk[1] + u)
 
 
 @njit(inline="always")
@@ -415,11 +436,11 @@ def _solve(jac, c, lu, piv, r):
 # rather than inlined (_rosenbrock has four call sites): the same arithmetic, their code
 # once per kind, and about a quarter of the compile time of each kind's kernels.
 @njit(cache=True)
-def _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, jac, ft, work):
+def _linearise(kind, regime, v, t_abs, drv, clk, u, prm, track_energy, f0, jac, ft, work):
     """f at the step's start, its Jacobian on the state block (central differences) and
     its explicit time derivative (a difference quotient over an exactly representable
     increment)."""
-    pz, pv = _plate(drv, cnt, n0, u)
+    pz, pv = _plate(drv, clk, u)
     _rhs(kind, regime, v, t_abs, pz, pv, prm, track_energy, f0)
     probe = work[0]
     plus, minus = work[1], work[2]
@@ -445,9 +466,9 @@ def _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, j
     t_up = t_abs + dt_probe
     t_down = t_abs - dt_probe
     span = t_up - t_down
-    pz1, pv1 = _plate(drv, cnt, n0, u + (t_up - t_abs))
+    pz1, pv1 = _plate(drv, clk, u + (t_up - t_abs))
     _rhs(kind, regime, v, t_up, pz1, pv1, prm, track_energy, plus)
-    pz0, pv0 = _plate(drv, cnt, n0, u - (t_abs - t_down))
+    pz0, pv0 = _plate(drv, clk, u - (t_abs - t_down))
     _rhs(kind, regime, v, t_down, pz0, pv0, prm, track_energy, minus)
     inv = 1.0 / span
     for i in range(NV):
@@ -455,7 +476,7 @@ def _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, j
 
 
 @njit(cache=True)
-def _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, stage,
+def _rosenbrock(kind, regime, v, t_abs, drv, clk, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, stage,
                 rate, out):
     """One RODAS4 step of length h from v (quadratures of v are 0): fills ``out`` with the
     new state and the quadrature increments and ``k`` with the stages; returns the
@@ -473,7 +494,7 @@ def _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f
                 for j in range(s):
                     acc += STAGE_A[s, j] * k[j, i]
                 stage[i] = acc
-            pz, pv = _plate(drv, cnt, n0, u + STAGE_C[s] * h)
+            pz, pv = _plate(drv, clk, u + STAGE_C[s] * h)
             _rhs(kind, regime, stage, t_abs + STAGE_C[s] * h, pz, pv, prm, track_energy, rate)
         inv_h = 1.0 / h
         for i in range(NV):
@@ -509,7 +530,7 @@ def _dense(v, out, k, s, res):
 
 
 @njit(cache=True)
-def _explicit(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, kx, stage, out):
+def _explicit(kind, regime, v, t_abs, drv, clk, u, h, prm, track_energy, f0, kx, stage, out):
     """One DOP853 step of length h from v (quadratures of v are 0; f0 the rate at v):
     fills ``out`` with the new state and the quadrature increments, ``kx`` with the 12
     stages and the rate at the new state, ``stage`` with the last stage's argument;
@@ -522,14 +543,14 @@ def _explicit(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0,
             for j in range(s):
                 acc += EXPLICIT_A[s, j] * kx[j, i]
             stage[i] = v[i] + h * acc
-        pz, pv = _plate(drv, cnt, n0, u + EXPLICIT_C[s] * h)
+        pz, pv = _plate(drv, clk, u + EXPLICIT_C[s] * h)
         _rhs(kind, regime, stage, t_abs + EXPLICIT_C[s] * h, pz, pv, prm, track_energy, kx[s])
     for i in range(NV):
         acc = 0.0
         for j in range(EXPLICIT_STAGES):
             acc += EXPLICIT_B[j] * kx[j, i]
         out[i] = v[i] + h * acc
-    pz, pv = _plate(drv, cnt, n0, u + h)
+    pz, pv = _plate(drv, clk, u + h)
     _rhs(kind, regime, out, t_abs + h, pz, pv, prm, track_energy, kx[EXPLICIT_STAGES])
     rtol, atol = prm[P_RTOL], prm[P_ATOL]
     err5 = err3 = 0.0
@@ -613,12 +634,12 @@ def _control_exponent(explicit):
 
 
 @njit(inline="always")
-def _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, kx,
+def _step(explicit, kind, regime, v, t_abs, drv, clk, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, kx,
           stage, rate, out):
     """One step of the method in use; its weighted RMS error."""
     if explicit:
-        return _explicit(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, kx, stage, out)
-    return _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, stage,
+        return _explicit(kind, regime, v, t_abs, drv, clk, u, h, prm, track_energy, f0, kx, stage, out)
+    return _rosenbrock(kind, regime, v, t_abs, drv, clk, u, h, prm, track_energy, f0, jac, ft, lu, piv, k, stage,
                        rate, out)
 
 
@@ -681,10 +702,11 @@ NA = NV + 2             # affine model on (delta, quadratures, 1, n)
 
 
 @njit(cache=True)
-def _period(kind, regime, v0, t_abs, shift, drv, cnt, n0, u, period, cap, h_first, prm, track_energy, hs, n_hs,
+def _period(kind, regime, v0, t_abs, shift, drv, clk, period, cap, h_first, prm, track_energy, hs, n_hs,
             out, margins, scale, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx):
-    """One plate period from v0 (quadratures of v0 are 0): with n_hs = 0 by error-controlled
-    steps whose lengths are recorded in hs, else by replaying hs[:n_hs].  ``shift`` moves
+    """One plate period from v0 at the clock's origin (quadratures of v0 are 0): with
+    n_hs = 0 by error-controlled steps whose lengths are recorded in hs, else by
+    replaying hs[:n_hs].  ``shift`` moves
     the drive's far end (the time the forces see, not the plate's).  Writes the end state
     and the period's quadrature increments to ``out``, each event value's minimum over the
     step ends and interpolant samples to ``margins``, and each state component's largest
@@ -694,7 +716,7 @@ def _period(kind, regime, v0, t_abs, shift, drv, cnt, n0, u, period, cap, h_firs
     for i in range(NV):
         out[i] = 0.0
         probe[i] = v0[i]
-    pz, pv = _plate(drv, cnt, n0, u)
+    pz, pv = _plate(drv, clk, 0.0)
     for e in range(n_events):
         margins[e] = _value(kind, regime, e, v0, t_abs + shift, pz, pv, prm)
         if margins[e] <= 0.0:
@@ -717,13 +739,13 @@ def _period(kind, regime, v0, t_abs, shift, drv, cnt, n0, u, period, cap, h_firs
                 break
             h = hs[steps]
         if explicit:
-            pz, pv = _plate(drv, cnt, n0, u + local)
+            pz, pv = _plate(drv, clk, local)
             _rhs(kind, regime, probe, t_abs + shift + local, pz, pv, prm, track_energy, f0)
         else:
-            _linearise(kind, regime, probe, t_abs + shift + local, drv, cnt, n0, u + local, prm, track_energy, f0,
+            _linearise(kind, regime, probe, t_abs + shift + local, drv, clk, local, prm, track_energy, f0,
                        jac, ft, scratch)
             tally[2] += 1
-        err = _step(explicit, kind, regime, probe, t_abs + shift + local, drv, cnt, n0, u + local, h, prm,
+        err = _step(explicit, kind, regime, probe, t_abs + shift + local, drv, clk, local, h, prm,
                     track_energy, f0, jac, ft, lu, piv, k, kx, stage, rate, trial)
         exponent = _control_exponent(explicit)
         if record and not err <= 1.0:
@@ -742,7 +764,7 @@ def _period(kind, regime, v0, t_abs, shift, drv, cnt, n0, u, period, cap, h_firs
                     scratch[0, i] = trial[i]
             else:
                 _interpolate(explicit, probe, trial, k, kx, h, s, scratch[0])
-            pz, pv = _plate(drv, cnt, n0, u + local + s * h)
+            pz, pv = _plate(drv, clk, local + s * h)
             for e in range(n_events):
                 g = _value(kind, regime, e, scratch[0], t_abs + shift + local + s * h, pz, pv, prm)
                 if g <= 0.0:
@@ -806,13 +828,15 @@ def _apply_periods(g, periods, y0, vec, moved, work, sq, tmp):
 
 
 @njit(cache=True)
-def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h_first, prm, track_energy, dq,
+def _stroboscopic(kind, regime, v, t_base, drv, clk, u_end, period, cap, h_first, prm, track_energy, dq,
                   tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx):
-    """Take the plate periods from local time u K at a time while the block stays in the
-    ``regime`` (LOADED) without a switch (the section's comment above).  Moves v (state
-    slots) and returns the new local time (u if no jump was taken); dq gets the
-    quadratures' increments, tally (accepted, rejected, Jacobians, periods jumped) the
-    costs."""
+    """Take the plate periods from the clock's origin (time t_base) K at a time while the
+    block stays in the ``regime`` (LOADED) without a switch (the section's comment
+    above), up to local time u_end.  Moves v (state slots) and returns the time jumped
+    (0 if no jump was taken); dq gets the quadratures' increments, tally (accepted,
+    rejected, Jacobians, periods jumped) the costs.  Every period is replayed on the
+    clock's phase (the jumps span whole periods), so the plate it sees is the recorded
+    one to the bit."""
     n_events = _events_of(regime)[1]
     hs = np.empty(STROBE_STEPS)
     y0 = np.zeros(NV)
@@ -836,15 +860,17 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
     margins_mid = np.zeros(3)
     scale_mid = np.zeros(NS)
     curvature = np.zeros(4)
+    at = np.empty(2)  # the clock of a replayed period's start
+    u = 0.0
     for i in range(4):
         dq[i] = 0.0
     for i in range(NS):
         y0[i] = v[i]
-    n_hs = _period(kind, regime, y0, t_base + u, 0.0, drv, cnt, n0, u, period, cap, h_first, prm, track_energy, hs,
+    n_hs = _period(kind, regime, y0, t_base, 0.0, drv, clk, period, cap, h_first, prm, track_energy, hs,
                    0, base, margins, scale, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch,
                    explicit, kx)
     if n_hs <= 0:
-        return u
+        return 0.0
     rtol, atol, vd = prm[P_RTOL], prm[P_ATOL], prm[P_VD]
     jump = float(STROBE_FIRST)
     last_jump = 0.0
@@ -852,6 +878,7 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
     model_fresh = False  # ... taken at this y0
     while True:
         t_abs = t_base + u
+        at[0], at[1] = clk[0], clk[1] + u
         if model_current:
             model_fresh = False
         else:
@@ -868,7 +895,7 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
                 for i in range(NV):
                     moved[i] = y0[i]
                 moved[j] = y0[j] + step if side == 0 else y0[j] - step
-                if _period(kind, regime, moved, t_abs, 0.0, drv, cnt, n0, u, period, cap, h_first, prm,
+                if _period(kind, regime, moved, t_abs, 0.0, drv, at, period, cap, h_first, prm,
                            track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0, jac, ft, lu, piv, k,
                            stage, rate, trial, probe, scratch, explicit, kx) < 0:
                     return u
@@ -887,7 +914,7 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
             shift = STROBE_PULL / (prm[P_KD] * abs(vd))
             for side in range(2):
                 sign = 1.0 if side == 0 else -1.0
-                if _period(kind, regime, y0, t_abs, sign * shift, drv, cnt, n0, u, period, cap, h_first, prm,
+                if _period(kind, regime, y0, t_abs, sign * shift, drv, at, period, cap, h_first, prm,
                            track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0, jac, ft, lu, piv, k,
                            stage, rate, trial, probe, scratch, explicit, kx) < 0:
                     return u
@@ -924,14 +951,16 @@ def _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, 
             ok = math.isfinite(vec[0] + vec[1] + vec[2] + vec[3] + vec[4] + vec[5])
             steps = -1
             if ok:
-                steps = _period(kind, regime, moved, t_abs + count * period, 0.0, drv, cnt, n0, u + count * period,
+                at[1] = clk[1] + u + count * period
+                steps = _period(kind, regime, moved, t_abs + count * period, 0.0, drv, at,
                                 period, cap, h_first, prm, track_energy, hs, n_hs, check, margins_moved, scale_moved, tally, f0,
                                 jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx)
             if steps > 0:
                 # The period halfway, replayed from the model's state there (quadratures' check).
                 mid = count // 2
                 _apply_periods(g, mid, y0, vec_mid, moved_mid, work, sq, tmp)
-                steps = _period(kind, regime, moved_mid, t_abs + mid * period, 0.0, drv, cnt, n0, u + mid * period,
+                at[1] = clk[1] + u + mid * period
+                steps = _period(kind, regime, moved_mid, t_abs + mid * period, 0.0, drv, at,
                                 period, cap, h_first, prm, track_energy, hs, n_hs, check_mid, margins_mid, scale_mid,
                                 tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe, scratch, explicit, kx)
             err = math.inf
@@ -1004,7 +1033,8 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     rejected, events, Jacobians, periods jumped) to costs[1:6].  Returns OK or a negative status."""
     kt = prm[P_KT]
     half_kt = 0.5 * kt
-    t_base = drv[D_T0] + n0 * drv[D_DT]
+    t_base = drv[D_T0] + n0 * drv[D_DT]  # the time at the clock's origin; local times u count from there
+    clk = _clock(drv, cnt, n0)
     v = np.zeros(NV)
     v[0], v[1], v[2], v[3], v[4] = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, phi_c = y[Y_PHI], y[Y_PHI_C]
@@ -1031,7 +1061,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     hold = 0
 
     # The regime of the stored state, with the friction rule applied to it.
-    pz, pv = _plate(drv, cnt, n0, 0.0)
+    pz, pv = _plate(drv, clk, 0.0)
     pen, bound = _bound(kind, v, t_base, pz, pv, prm)
     if pen > 0.0:
         if abs(kt * v[4]) >= bound:
@@ -1060,6 +1090,9 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         top = abs(drv[D_AMP]) + drv[D_EXT_Z]
     within_reach = False  # a step past the cap met the reach: capped until the next event
     strobe_next = 0.0
+    done = 0.0  # the time covered before the clock's origin
+    rebase_after = REBASE_CYCLES * 2.0 * math.pi / drv[D_OMEGA] if cap < math.inf else math.inf
+    try_clk = np.empty(2)
     strobe_wait = STROBE_WAIT
     refused = 0  # periods replayed by this call's refused tries (STROBE_TRY each)
     dq = np.zeros(4)
@@ -1067,7 +1100,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     rtol = prm[P_RTOL]
     h = h_want = min(cap, 0.1 * rtol ** 0.25)  # h_want: the error control's step, before the cap
     # The first method: the explicit pair unless the first step already meets its stability bound.
-    _linearise(kind, regime, v, t_base, drv, cnt, n0, 0.0, prm, track_energy, f0, jac, ft, scratch)
+    _linearise(kind, regime, v, t_base, drv, clk, 0.0, prm, track_energy, f0, jac, ft, scratch)
     jacobians += 1
     stiffest = _stiffest_rate(prm)
     explicit = next_explicit = h * max(_jacobian_norm(jac), stiffest) < EXPLICIT_CALM
@@ -1086,10 +1119,26 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             explicit = next_explicit
             fresh = False
             stagnant = 0
+        if u >= rebase_after:
+            # Move the clock's origin here, so that the plate's phase omega u never
+            # carries the rounding of a long local time (REBASE_CYCLES).
+            _advance_clock(drv, clk, u, False)
+            t_base += u
+            done += u
+            u_end -= u
+            last_reset -= u
+            strobe_next -= u
+            u = 0.0
+            t_abs = t_base
+            fresh = False  # the rate read on the moved clock, as after a try (whose bits it then matches)
         if (period > 0.0 and regime == LOADED and u >= strobe_next and u_end - u >= STROBE_PAYBACK * period
-                and STROBE_SHARE * u >= (refused + STROBE_TRY) * period):
+                and STROBE_SHARE * (done + u) >= (refused + STROBE_TRY) * period):
+            # The try runs on a clock whose origin is here; the call's clock moves there
+            # only if a jump is taken (a refused try leaves the run as it was, bit for bit).
+            try_clk[0], try_clk[1] = clk[0], clk[1]
+            _advance_clock(drv, try_clk, u, False)
             tally[:] = 0
-            u_jumped = _stroboscopic(kind, regime, v, t_base, drv, cnt, n0, u, u_end, period, cap, h, prm,
+            u_jumped = _stroboscopic(kind, regime, v, t_abs, drv, try_clk, u_end - u, period, cap, h, prm,
                                      track_energy, dq, tally, f0, jac, ft, lu, piv, k, stage, rate, trial, probe,
                                      scratch, explicit, kx)
             accepted += tally[0]
@@ -1097,8 +1146,15 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             jacobians += tally[2]
             jumped += tally[3]
             fresh = False  # the try's replays used f0, jac and the stages as scratch
-            if u_jumped > u:
-                u = u_jumped
+            if u_jumped > 0.0:
+                # Whole periods: the plate's phase at the landing is the try's, exactly.
+                _advance_clock(drv, try_clk, u_jumped, True)
+                clk[0], clk[1] = try_clk[0], try_clk[1]
+                t_base += u + u_jumped
+                done += u + u_jumped
+                u_end -= u + u_jumped
+                last_reset -= u + u_jumped
+                u = 0.0
                 phi, phi_c = kahan_add(phi, phi_c, dq[0])
                 work_sum += dq[1]
                 dissipated += dq[2]
@@ -1114,10 +1170,10 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             continue
         if not fresh:
             if explicit:
-                pz, pv = _plate(drv, cnt, n0, u)
+                pz, pv = _plate(drv, clk, u)
                 _rhs(kind, regime, v, t_abs, pz, pv, prm, track_energy, f0)
             else:
-                _linearise(kind, regime, v, t_abs, drv, cnt, n0, u, prm, track_energy, f0, jac, ft, scratch)
+                _linearise(kind, regime, v, t_abs, drv, clk, u, prm, track_energy, f0, jac, ft, scratch)
                 jacobians += 1
             fresh = True
         if regime == FLIGHT and h_want > cap and not within_reach and top == top:
@@ -1127,7 +1183,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         if not explicit and stagnant >= LEAP_AFTER and LEAP * h < cap:
             stagnant = 0
             h_leap = min(LEAP * h, remaining)
-            err = _rosenbrock(kind, regime, v, t_abs, drv, cnt, n0, u, h_leap, prm, track_energy, f0, jac, ft, lu,
+            err = _rosenbrock(kind, regime, v, t_abs, drv, clk, u, h_leap, prm, track_energy, f0, jac, ft, lu,
                               piv, k, stage, rate, trial)
             if err <= 1.0:
                 h = h_leap
@@ -1137,7 +1193,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
         if last:
             h = remaining
         if not err <= 1.0:
-            err = _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, h, prm, track_energy, f0, jac, ft, lu, piv,
+            err = _step(explicit, kind, regime, v, t_abs, drv, clk, u, h, prm, track_energy, f0, jac, ft, lu, piv,
                         k, kx, stage, rate, trial)
         exponent = _control_exponent(explicit)
         if not err <= 1.0:
@@ -1198,14 +1254,14 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                     probe[i] = trial[i]
             else:
                 _interpolate(explicit, v, trial, k, kx, h, s, probe)
-            pz, pv = _plate(drv, cnt, n0, u + s * h)
+            pz, pv = _plate(drv, clk, u + s * h)
             earliest = math.inf
             for e in range(n_events):
                 if _value(kind, regime, e, probe, t_base + (u + s * h), pz, pv, prm) < 0.0:
                     # the interpolant's root in (previous, s): a few regula falsi iterations
                     a, b = previous, s
                     _interpolate(explicit, v, trial, k, kx, h, a, best)
-                    pza, pva = _plate(drv, cnt, n0, u + a * h)
+                    pza, pva = _plate(drv, clk, u + a * h)
                     ga = _value(kind, regime, e, best, t_base + (u + a * h), pza, pva, prm)
                     if a == 0.0:
                         ga = max(ga, 0.0)
@@ -1217,7 +1273,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                             if not (a < root < b):
                                 root = 0.5 * (a + b)
                             _interpolate(explicit, v, trial, k, kx, h, root, best)
-                            pzr, pvr = _plate(drv, cnt, n0, u + root * h)
+                            pzr, pvr = _plate(drv, clk, u + root * h)
                             gr = _value(kind, regime, e, best, t_base + (u + root * h), pzr, pvr, prm)
                             if gr < 0.0:
                                 b, gb = root, gr
@@ -1264,7 +1320,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             if _event_at(regime, e) == event:
                 e_index = e
         tol = max(EVENT_TOL, 4.0 * EPS * (abs(t_abs) + h))
-        pz, pv = _plate(drv, cnt, n0, u)
+        pz, pv = _plate(drv, clk, u)
         lo, g_lo = 0.0, max(_value(kind, regime, e_index, v, t_abs, pz, pv, prm), 0.0)
         hi, g_hi = -1.0, 0.0
         for attempt in range(3):
@@ -1275,9 +1331,9 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 for i in range(NV):
                     probe[i] = trial[i]
             else:
-                _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, length, prm, track_energy, f0, jac, ft, lu,
+                _step(explicit, kind, regime, v, t_abs, drv, clk, u, length, prm, track_energy, f0, jac, ft, lu,
                       piv, k, kx, stage, rate, probe)
-            pz, pv = _plate(drv, cnt, n0, u + length)
+            pz, pv = _plate(drv, clk, u + length)
             g = _value(kind, regime, e_index, probe, t_base + (u + length), pz, pv, prm)
             if g < 0.0:
                 hi, g_hi = length, g
@@ -1308,9 +1364,9 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 guess = 0.5 * (lo + hi)
                 if not (lo < guess < hi):
                     break
-            _step(explicit, kind, regime, v, t_abs, drv, cnt, n0, u, guess, prm, track_energy, f0, jac, ft, lu, piv,
+            _step(explicit, kind, regime, v, t_abs, drv, clk, u, guess, prm, track_energy, f0, jac, ft, lu, piv,
                   k, kx, stage, rate, probe)
-            pz, pv = _plate(drv, cnt, n0, u + guess)
+            pz, pv = _plate(drv, clk, u + guess)
             g = _value(kind, regime, e_index, probe, t_base + (u + guess), pz, pv, prm)
             if g < 0.0:
                 hi, g_hi = guess, g
@@ -1343,7 +1399,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 break
         else:
             immediate = 0
-        pz, pv = _plate(drv, cnt, n0, u)
+        pz, pv = _plate(drv, clk, u)
         pen, bound = _bound(kind, v, t_base + u, pz, pv, prm)
         if event == EV_CONTACT:
             v[4] = 0.0
@@ -1422,7 +1478,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         else:
             slips = costs[0]
     t = drv[D_T0] + n * drv[D_DT] + h
-    pz, pv = _plate(drv, cnt, n, h)
+    pz, pv = _plate(drv, _clock(drv, cnt, n), h)
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], pz, pv, prm)
     record_observation(obs, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F], pen, normal, cos_a, out[Y_PHI], slips,
                        t, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL], pen > 0.0,

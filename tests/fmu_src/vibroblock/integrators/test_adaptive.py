@@ -329,9 +329,9 @@ def test_stroboscopic_jumps_agree_with_every_period_resolved(model):
 
 def test_jumps_hold_two_billion_tau_0_after_the_time_origin():
     """The same held stick started at t ~ 2e9 (a crest ~4e5 delta_0 down the corrugation, where
-    the drive spring is relaxed then): the plate's phase is reduced at each call's start,
-    so its rounding is a constant of the call, not a ~1e-8 noise between replays of a period
-    that the jumps' check would refuse (at 2e9 the sum omega (t + u) rounds to ~1e-7 rad).
+    the drive spring is relaxed then): the plate's phase is reduced at the clock's origin
+    (``_clock``), so its rounding is not a ~1e-8 noise between replays of a period that the
+    jumps' check would refuse (at 2e9 the sum omega (t + u) rounds to ~1e-7 rad).
     The jumps cross as many periods as near t = 0 and agree with every period resolved."""
     from vibroblock import defaults
     horizon = 2e4
@@ -345,6 +345,22 @@ def test_jumps_hold_two_billion_tau_0_after_the_time_origin():
     assert abs(out["x"] - ref["x"]) <= 1e-8 * abs(ref["x"]) + 1e-6
     assert abs(out["friction_force"] - ref["friction_force"]) <= 1e-8
     assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-6 * ref["phi_integral"]
+
+
+def test_one_long_call_jumps_as_cheaply_as_many_short_ones():
+    """The held stick over 3e7 tau_0 (1e6 plate periods, the FMU's default tolerances) in one
+    call and in thirty: the plate's clock moves its origin to each jump's landing, so the
+    phase a replayed period sees does not carry the rounding of omega u at u ~ 3e7 (~1e-9
+    rad), a noise that the jumps' check refused late in one long call (with the phase summed
+    from the call's start: 9.0e6 steps in one call against 1.3e6 in thirty)."""
+    one, thirty = (_vibrated_stick("C", 1e12, 3e7, omega=0.2, calls=calls, formulation=1) for calls in (1, 30))
+    assert one.counters["periods_jumped"] > 0.99 * 3e7 / (2 * math.pi / 0.2)
+    assert one.counters["accepted"] < 1.5 * thirty.counters["accepted"]
+    ref, out = thirty.outputs(), one.outputs()
+    assert out["slip_count"] == ref["slip_count"] == 0
+    assert abs(out["x"] - ref["x"]) <= 1e-7
+    assert abs(out["friction_force"] - ref["friction_force"]) <= 1e-10
+    assert abs(out["phi_integral"] - ref["phi_integral"]) <= 1e-7 * ref["phi_integral"]
 
 
 def test_jumps_tried_and_refused_leave_the_run_as_it_was():

@@ -168,4 +168,4 @@ def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive_a
     diagram = legends["model_c_phase_diagram.png"]
     assert any("A_c" in label for label in diagram) and any("A_N" in label for label in diagram)
     assert "Fig. 5" in titles["model_c_phase_diagram.png"] and "Fig. 6" in titles["omega2_vs_k_n.png"]
-    assert all("scaled drive" in title and "out of reach" in title for title in titles.values())
+    assert all("scaled drive" in title and "fig5_paper" in title for title in titles.values())
