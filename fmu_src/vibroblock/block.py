@@ -14,6 +14,7 @@ import numpy as np
 from . import interface
 from . import layout as L
 from .initial_state import frame_to_point, place
+from .integrators.plate import reduced_phase
 from .native import LAYOUT, OBSERVED_OK, RETURNED_OK, SURFACE_Z, ZERO, NativeStep, entry_address
 from .settings import ModelError, Settings
 
@@ -176,7 +177,7 @@ class Block:
         self.drv = np.zeros(L.N_DRV)
         self.drv[L.D_T0], self.drv[L.D_DT] = t0, p["dt"]
         self.drv[L.D_AMP], self.drv[L.D_OMEGA] = p["A"], p["omega"]
-        self.drv[L.D_PHASE], self.drv[L.D_EXT_T] = p["omega"] * t0, t0
+        self.drv[L.D_PHASE], self.drv[L.D_EXT_T] = reduced_phase(0.0, p["omega"], t0), t0
         self.cnt = np.zeros(L.N_CNT, dtype=np.int64)
         self.y = np.zeros(L.N_Y)
         self.obs = np.zeros(L.N_OBS)
@@ -199,7 +200,8 @@ class Block:
     def _retune_drive(self) -> None:
         """Take new A, omega from the current grid step on, keeping the phase continuous."""
         n = self.cnt[L.C_STEP]
-        phase = self.drv[L.D_PHASE] + self.drv[L.D_OMEGA] * self.drv[L.D_DT] * (n - self.cnt[L.C_PHASE_STEP])
+        step_rate = self.drv[L.D_OMEGA] * self.drv[L.D_DT]  # the kernels' phase per grid step
+        phase = reduced_phase(self.drv[L.D_PHASE], step_rate, n - self.cnt[L.C_PHASE_STEP])
         self.drv[L.D_PHASE], self.cnt[L.C_PHASE_STEP] = phase, n
         self.drv[L.D_AMP], self.drv[L.D_OMEGA] = self.parameters["A"], self.parameters["omega"]
         self._observed = None

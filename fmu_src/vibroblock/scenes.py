@@ -40,7 +40,7 @@ from numba import literally, njit
 
 from .dynamics import contact, friction_rule
 from .integrators.fixed_step import OK, STOP, record_observation
-from .integrators.plate import drive_sin_cos, phase_at_time, plate_at, plate_at_time
+from .integrators.plate import drive_sin_cos, phase_after, plate_after, plate_at
 from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M,
                      P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .models import load, profile
@@ -216,8 +216,8 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     s0, c0 = drive_sin_cos(drv, cnt, cnt[C_STEP])
     pz0, pv0 = plate_at(drv, s0, c0, t)
     if h > 0.0:
-        pz1, pv1 = plate_at_time(drv, cnt, t + h)
-        phase = phase_at_time(drv, cnt, t + h)
+        pz1, pv1 = plate_after(drv, cnt, cnt[C_STEP], h)
+        phase = phase_after(drv, cnt, cnt[C_STEP], h)
         pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase),
                                          drv[D_EXT_A])
         x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
@@ -237,8 +237,8 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         t += h
         pz0, pv0 = pz1, pv1
     # The forces acting at the reported state: those of a step of dt starting there.
-    pz2, pv2 = plate_at_time(drv, cnt, t + dt)
-    phase = phase_at_time(drv, cnt, t + dt)
+    pz2, pv2 = plate_after(drv, cnt, cnt[C_STEP], h + dt)
+    phase = phase_after(drv, cnt, cnt[C_STEP], h + dt)
     pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase), drv[D_EXT_A])
     probe = scene_step(kind, flags, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz2, pv2, pen_f, un_f, False)
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz0, pv0, prm)

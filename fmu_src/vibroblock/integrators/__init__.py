@@ -8,7 +8,7 @@ scheme is a ``prepare``/``step`` pair run by the shared driver (``fixed_step``);
 integrator that is not fixed-step brings its own ``advance``/``observe`` kernels
 (``event_driven``).
 
-The contract every integrator keeps (``tests/fmu_src/vibroblock/test_integrators.py``
+The contract every integrator keeps (``tests/fmu_src/vibroblock/integrators/test_contract.py``
 checks every registered one against the rules a test can check):
 
 1. Grid.  The state is stored on the grid t_n = t0 + n dt, n = cnt[C_STEP]; time is
@@ -23,7 +23,9 @@ checks every registered one against the rules a test can check):
 3. Splits.  The plate drive is a function of the grid index alone, so advancing n1 + n2
    steps in two calls gives the same bits as n1 + n2 in one (an integrator whose
    ``splits_bitwise`` is False -- exact flows with located events -- agrees to its
-   event tolerance instead).
+   event tolerance instead).  Its phase comes from ``plate.drive_phase`` (off the grid:
+   ``plate.phase_after``), reduced modulo 2 pi without rounding the product omega t,
+   so the plate is the same to ~1e-15 at t ~ 1e12 as near t = 0.
 4. Failure.  ``advance`` returns 0 (OK), 1 (STOP: a guard stopped it early, the steps
    taken are stored) or a negative status from ``statuses``; on a negative status the
    arrays are exactly as they were on entry (the last good state).

@@ -108,8 +108,9 @@ from numba import literally, njit
 
 from ..dynamics import contact, coulomb_bound, energy_rates, force, plate_motion, position_rates, surface_contact
 from .fixed_step import kahan_add, record_observation
-from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_PHASE_STEP, C_REJECTED, C_SLIPS, C_STEP,
-                      D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0, N_OBS, P_ATOL, P_GN,
+from .plate import TWO_PI, drive_phase
+from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_REJECTED, C_SLIPS, C_STEP,
+                      D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_T0, N_OBS, P_ATOL, P_GN,
                       P_GT, P_KD, P_KN, P_KT, P_M, P_MAX_JUMP, P_MUS, P_RTOL, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F,
                       Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..readings import free_flight
@@ -186,7 +187,6 @@ DENSE = np.array([
     [-0.6762803392801253, 6.087714651680015, 16.43084320892478, 24.76722511418386, -6.594389125716872]])
 
 EPS = 2.220446049250313e-16
-TWO_PI = 2.0 * math.pi
 JAC_STEP = 1e-5  # relative increment of the central differences (~eps^(1/3))
 
 # DOP853 (Dormand & Prince's explicit pair of order 8 with error estimators of orders 5
@@ -217,14 +217,13 @@ STIFF_HOLD = 32
 # --------------------------------------------------------------------------- physics
 @njit(inline="always")
 def _clock(drv, cnt, n0):
-    """The plate's clock at grid step n0: (its phase reduced modulo 2 pi, the external
-    input's time).  A call reads the plate from local times u after its clock's origin,
-    phase + omega u: reduced once, the sum rounds to ~1e-16 of omega u, where omega (t + u)
-    at t ~ 1e9 would round to ~1e-7 rad and put the plate ~1e-8 off between replays of a
-    period (the stroboscopic jumps' check refused every jump there)."""
-    phase = drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n0 - cnt[C_PHASE_STEP])
+    """The plate's clock at grid step n0: (its phase in [0, 2 pi), the external input's
+    time).  A call reads the plate from local times u after its clock's origin,
+    phase + omega u: the sum rounds to ~1e-16 of omega u, where omega (t + u) at t ~ 1e9
+    would round to ~1e-7 rad and put the plate ~1e-8 off between replays of a period
+    (the stroboscopic jumps' check refused every jump there)."""
     clk = np.empty(2)
-    clk[0] = phase - TWO_PI * math.floor(phase / TWO_PI)
+    clk[0] = drive_phase(drv, cnt, n0)
     clk[1] = (drv[D_T0] - drv[D_EXT_T]) + n0 * drv[D_DT]
     return clk
 

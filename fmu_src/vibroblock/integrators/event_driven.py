@@ -66,8 +66,9 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
 from .fixed_step import record_observation
+from .plate import grid_phase, phase_after
 from ..layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
-                      D_PHASE, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL,
+                      D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL,
                       Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS)
 
 # Events are located to this time (tau_0) past their true zero, or to 8 ulp of the time
@@ -609,7 +610,7 @@ def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, 
     """
     m, grav, k_n, k_t = prm[P_M], prm[P_G], prm[P_KN], prm[P_KT]
     gam_n, gam_t, mu_s, k_d, v_d = prm[P_GN], prm[P_GT], prm[P_MUS], prm[P_KD], prm[P_VD]
-    t0, dt, amp, om, phase0 = drv[D_T0], drv[D_DT], drv[D_AMP], drv[D_OMEGA], drv[D_PHASE]
+    t0, dt, amp, om = drv[D_T0], drv[D_DT], drv[D_AMP], drv[D_OMEGA]
     ext_z, ext_v, ext_a = drv[D_EXT_Z], drv[D_EXT_V], drv[D_EXT_A]
     ext_origin = t0 - drv[D_EXT_T]
     half_kt = 0.5 * k_t
@@ -634,7 +635,7 @@ def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, 
     y_s = yh0 = yh1 = nh0 = nh1 = 0.0
 
     # Which side of each switch the stored state is on.
-    th = phase0 + om * (dt * (n_ref - anchor) + off)
+    th = grid_phase(drv, anchor, n_ref) + om * off
     tau_e = ext_origin + n_ref * dt + off
     plate_z = amp * math.sin(th) + ext_z + tau_e * (ext_v + 0.5 * ext_a * tau_e)
     plate_v = amp * om * math.cos(th) + ext_v + ext_a * tau_e
@@ -675,7 +676,7 @@ def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, 
         u_rem = (n_to - n_ref) * dt + (off_to - off)
         if u_rem <= 0.0:
             break
-        th = phase0 + om * (dt * (n_ref - anchor) + off)
+        th = grid_phase(drv, anchor, n_ref) + om * off
         tau_e = ext_origin + n_ref * dt + off
         e_th = complex(math.cos(th), math.sin(th))
         plate_z = amp * e_th.imag + ext_z + tau_e * (ext_v + 0.5 * ext_a * tau_e)
@@ -975,7 +976,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             slips = cnt[C_SLIPS]
     dt, om = drv[D_DT], drv[D_OMEGA]
     t = drv[D_T0] + n * dt + h
-    th = drv[D_PHASE] + om * (dt * (n - cnt[C_PHASE_STEP]) + h)
+    th = phase_after(drv, cnt, n, h)
     tau_e = t - drv[D_EXT_T]
     plate_z = drv[D_AMP] * math.sin(th) + drv[D_EXT_Z] + tau_e * (drv[D_EXT_V] + 0.5 * drv[D_EXT_A] * tau_e)
     plate_v = drv[D_AMP] * om * math.cos(th) + drv[D_EXT_V] + drv[D_EXT_A] * tau_e

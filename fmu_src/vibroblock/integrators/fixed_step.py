@@ -35,7 +35,7 @@ from ..dynamics import contact, coulomb_bound, friction_rule
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
                       P_KT, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
-from .plate import next_sin_cos, phase_at_time, plate_at, plate_at_time, plate_moves, drive_sin_cos
+from .plate import drive_sin_cos, next_sin_cos, phase_after, plate_after, plate_at, plate_moves
 
 OK, STOP = 0, 1
 NON_FINITE = -1
@@ -183,12 +183,13 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, slips = y[Y_PHI], cnt[C_SLIPS]
     work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
-    pz0, pv0 = plate_at_time(drv, cnt, t)
+    n = cnt[C_STEP]
+    pz0, pv0 = plate_after(drv, cnt, n, 0.0)
     state_contact = contact(kind, x, z, vx, vz, pz0, pv0, prm)
     if h > 0.0:
         ctx = prepare(kind, flags, drv, prm, h)
-        pzh, pvh = plate_at_time(drv, cnt, t + 0.5 * h)
-        phase1 = phase_at_time(drv, cnt, t + h)
+        pzh, pvh = plate_after(drv, cnt, n, 0.5 * h)
+        phase1 = phase_after(drv, cnt, n, h)
         s1, c1 = math.sin(phase1), math.cos(phase1)
         pz1, pv1 = plate_at(drv, s1, c1, t + h)
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,

@@ -6,8 +6,17 @@ changed), so a run split anywhere sees the same plate.  In the step loops its si
 cosine advance by a rotation each step (a sin/cos pair costs more than a whole model-A
 step) and are recomputed exactly every RESYNC steps from the anchor, so rounding cannot
 build up and the values depend on n only.
+
+The phase is kept reduced modulo 2 pi, and the product omega dt (n - anchor) is reduced
+exactly (double-double arithmetic): summed as a plain double, omega t at t ~ 1e9 rounds
+to ~1e-7 rad, so the plate would jitter by ~1e-7 A between evaluations and a run started
+far from t = 0 would see another plate than one started at 0.  The phase at the start
+and where omega changes is reduced exactly too (``reduced_phase``), so the phase at
+grid step n is the drive's omega-dt multiple of n plus the anchor's, to ~1e-16 rad at
+any n.
 """
 import math
+from fractions import Fraction
 
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
@@ -16,11 +25,49 @@ from ..dynamics import plate_motion
 from ..layout import C_PHASE_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0
 
 RESYNC = 256
+TWO_PI = 2.0 * math.pi
+TWO_PI_TAIL = 2.4492935982947064e-16  # 2 pi - TWO_PI, so that the pair holds 2 pi to ~1e-32
+# 2 pi to 60 digits, for the exact reductions done in Python.
+TWO_PI_EXACT = Fraction("6.28318530717958647692528676655900576839433879875021164194988918")
+VELTKAMP = 134217729.0  # 2**27 + 1: splits a double into two halves whose products are exact
+
+
+@njit(inline="always")
+def _exact_product(a, b):
+    """a * b as an unevaluated sum p + e of two doubles, exactly (Dekker)."""
+    p = a * b
+    t = VELTKAMP * a
+    a_hi = t - (t - a)
+    a_lo = a - a_hi
+    t = VELTKAMP * b
+    b_hi = t - (t - b)
+    b_lo = b - b_hi
+    return p, ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
 
 
 @njit(inline="always")
 def drive_phase(drv, cnt, n):
-    return drv[D_PHASE] + drv[D_OMEGA] * drv[D_DT] * (n - cnt[C_PHASE_STEP])
+    """The drive's phase at grid step n, in [0, 2 pi)."""
+    return grid_phase(drv, cnt[C_PHASE_STEP], n)
+
+
+@njit(inline="always")
+def grid_phase(drv, anchor, n):
+    """The drive's phase at grid step n in [0, 2 pi): the anchor's phase plus
+    (omega dt) (n - anchor), the product reduced modulo 2 pi before it is rounded."""
+    rise, rise_tail = _exact_product(drv[D_OMEGA] * drv[D_DT], float(n - anchor))
+    turns = math.floor(rise / TWO_PI)
+    whole, whole_tail = _exact_product(turns, TWO_PI)
+    # rise - whole is exact (the two agree to within a few 2 pi; Sterbenz).
+    phase = ((rise - whole) + (rise_tail - whole_tail) - turns * TWO_PI_TAIL) + drv[D_PHASE]
+    return phase - TWO_PI * math.floor(phase / TWO_PI)
+
+
+def reduced_phase(phase, rate, elapsed):
+    """(phase + rate * elapsed) modulo 2 pi, in [0, 2 pi), from the exact product of the
+    two doubles: where the drive's phase is set (start, a change of omega) in Python."""
+    exact = Fraction(phase) + Fraction(rate) * Fraction(elapsed)
+    return float(exact - TWO_PI_EXACT * math.floor(exact / TWO_PI_EXACT))
 
 
 @njit(inline="always")
@@ -61,13 +108,13 @@ def plate_moves(drv):
 
 
 @njit(inline="always")
-def phase_at_time(drv, cnt, t):
-    anchor_time = drv[D_T0] + cnt[C_PHASE_STEP] * drv[D_DT]
-    return drv[D_PHASE] + drv[D_OMEGA] * (t - anchor_time)
+def phase_after(drv, cnt, n, h):
+    """The drive's phase a time h after grid step n (off the grid)."""
+    return drive_phase(drv, cnt, n) + drv[D_OMEGA] * h
 
 
 @njit(inline="always")
-def plate_at_time(drv, cnt, t):
-    """Plate height and velocity at an arbitrary time (off the grid): exact sin/cos."""
-    phase = phase_at_time(drv, cnt, t)
-    return plate_at(drv, math.sin(phase), math.cos(phase), t)
+def plate_after(drv, cnt, n, h):
+    """Plate height and velocity a time h after grid step n (off the grid): exact sin/cos."""
+    phase = phase_after(drv, cnt, n, h)
+    return plate_at(drv, math.sin(phase), math.cos(phase), drv[D_T0] + n * drv[D_DT] + h)

@@ -3,6 +3,7 @@
 The checks run over the registry itself, so an integrator added there is checked here
 without a line of this file changing."""
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -90,6 +91,24 @@ def test_rule_3_any_split_of_a_run_gives_the_same_result(record, model, keywords
         bound = 1e2 * tight.get("rtol", 1e-11)
         for name, value in one.items():
             assert many[name] == pytest.approx(value, rel=bound, abs=bound), name
+
+
+@pytest.mark.parametrize("t0", [2.0**31, 2.0**40])
+@pytest.mark.parametrize("record, model, keywords", list(cases()))
+def test_rule_3_the_plate_is_exact_at_any_time(record, model, keywords, t0):
+    """Started at t0 ~ 2e9 or 1e12, the surface at each grid point is A sin(omega t) to
+    ~1e-15: omega t summed in doubles would be ~1e-7 (2e9) to ~1e-4 rad (1e12) off.  The
+    times t0 + n dt are exact doubles here (dt a power of 2), so the comparison is sharp."""
+    drive = {key: VIBRATED[key] for key in ("A", "omega")}
+    block = make(model, keywords, dt=2.0**-8, x_start=SCALED["V_d"] * t0, **drive)
+    block.start(t0)
+    turn = 2 * Fraction("3.14159265358979323846264338327950288419716939937510582097494459")
+    for k in range(1, 41):
+        t = t0 + 0.25 * k
+        block.advance_to(t)
+        phase = Fraction(drive["omega"]) * Fraction(t)
+        phase -= turn * math.floor(phase / turn)
+        assert block.output("surface_z") == pytest.approx(drive["A"] * math.sin(float(phase)), abs=1e-14), t
 
 
 @pytest.mark.parametrize("record, model, keywords", list(cases()))

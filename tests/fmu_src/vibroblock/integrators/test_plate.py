@@ -1,0 +1,39 @@
+"""The drive's phase on the grid (``vibroblock.integrators.plate``) against exact rationals."""
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from vibroblock import layout as L
+from vibroblock.integrators.plate import drive_phase, reduced_phase
+
+TURN = 2 * Fraction("3.14159265358979323846264338327950288419716939937510582097494459")
+
+
+def exact(phase, rate, steps):
+    value = Fraction(phase) + Fraction(rate) * steps
+    return value - TURN * math.floor(value / TURN)
+
+
+@pytest.mark.parametrize("omega, dt", [(0.316, 4e-4), (1.3, 1e-2), (1e3, 1e-5), (2e-2, 0.5)])
+def test_drive_phase_is_the_exact_multiple_reduced_at_any_step(omega, dt):
+    drv, cnt = np.zeros(L.N_DRV), np.zeros(L.N_CNT, dtype=np.int64)
+    drv[L.D_OMEGA], drv[L.D_DT], drv[L.D_PHASE] = omega, dt, 5.1
+    cnt[L.C_PHASE_STEP] = 1234
+    rate = omega * dt  # the kernels' phase per grid step
+    worst = 0.0
+    for n in [1234, 1235, 10**6, 2**40 + 7, 3 * 10**13, 2**52 - 1]:
+        phase = drive_phase(drv, cnt, n)
+        assert 0.0 <= phase < 2 * math.pi
+        distance = abs(Fraction(phase) - exact(5.1, rate, n - 1234))
+        worst = max(worst, float(min(distance, TURN - distance)))
+    # A double sum would be off by up to ~1e-4 rad at the largest steps.
+    assert worst < 4e-15
+
+
+def test_reduced_phase_is_exact_for_large_products():
+    for phase, rate, elapsed in [(0.0, 0.316, 2e9), (3.0, 1e3, 1e12), (6.2, 2e-2, 0.0), (0.0, 0.0, 1e15)]:
+        value = reduced_phase(phase, rate, elapsed)
+        assert 0.0 <= value < 2 * math.pi
+        assert abs(value - float(exact(phase, rate, Fraction(elapsed)))) < 1e-15
