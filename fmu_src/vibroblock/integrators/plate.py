@@ -16,6 +16,7 @@ grid step n is the drive's omega-dt multiple of n plus the anchor's, to ~1e-16 r
 any n.
 """
 import math
+import numbers
 from fractions import Fraction
 
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
@@ -66,7 +67,9 @@ def grid_phase(drv, anchor, n):
 def reduced_phase(phase, rate, elapsed):
     """(phase + rate * elapsed) modulo 2 pi, in [0, 2 pi), from the exact product of the
     two doubles: where the drive's phase is set (start, a change of omega) in Python."""
-    exact = Fraction(phase) + Fraction(rate) * Fraction(elapsed)
+    # Python numbers only: numpy's fixed-width integers overflow inside Fraction.
+    elapsed = int(elapsed) if isinstance(elapsed, numbers.Integral) else float(elapsed)
+    exact = Fraction(float(phase)) + Fraction(float(rate)) * Fraction(elapsed)
     return float(exact - TWO_PI_EXACT * math.floor(exact / TWO_PI_EXACT))
 
 

@@ -33,7 +33,13 @@ def test_drive_phase_is_the_exact_multiple_reduced_at_any_step(omega, dt):
 
 
 def test_reduced_phase_is_exact_for_large_products():
-    for phase, rate, elapsed in [(0.0, 0.316, 2e9), (3.0, 1e3, 1e12), (6.2, 2e-2, 0.0), (0.0, 0.0, 1e15)]:
-        value = reduced_phase(phase, rate, elapsed)
-        assert 0.0 <= value < 2 * math.pi
-        assert abs(value - float(exact(phase, rate, Fraction(elapsed)))) < 1e-15
+    cases = [(0.0, 0.316, 2e9), (3.0, 1e3, 1e12), (6.2, 2e-2, 0.0), (0.0, 0.0, 1e15), (1.0, 2e-4, 3 * 10**13)]
+    for phase, rate, elapsed in cases:
+        expected = float(exact(phase, rate, Fraction(elapsed)))
+        # As Block passes them: numpy scalars (whose int64 would overflow inside Fraction).
+        as_numpy = (np.float64(phase), np.float64(rate),
+                    np.int64(elapsed) if isinstance(elapsed, int) else np.float64(elapsed))
+        for arguments in ((phase, rate, elapsed), as_numpy):
+            value = reduced_phase(*arguments)
+            assert 0.0 <= value < 2 * math.pi
+            assert abs(value - expected) < 1e-15
