@@ -90,6 +90,44 @@ def test_the_explicit_pair_steps_motion_that_is_not_stiff_and_rodas4_motion_that
     assert error(block.outputs(), ref) < 1e-6
 
 
+def test_the_explicit_tableau_has_the_orders_it_is_used_for():
+    """The DOP853 tableau the kernel reads from scipy (a private module, pinned) steps an
+    ODE with a closed-form solution with local errors of order 9, and its two estimators
+    have orders 6 and 4: halving the step divides them by ~2^9, 2^6 and 2^4.  Should a
+    scipy release change the tableau, this fails before any result moves."""
+    from vibroblock.integrators.adaptive import (EXPLICIT_A, EXPLICIT_B, EXPLICIT_C, EXPLICIT_E3, EXPLICIT_E5,
+                                                 EXPLICIT_STAGES)
+
+    def rate(t, y):  # u' = cos(t) u, w' = w^2: u = u0 exp(sin t - sin t0), w = 1 / (1/w0 - (t - t0))
+        return np.array([math.cos(t) * y[0], y[1] * y[1]])
+
+    def step(t0, y0, h):
+        k = np.zeros((EXPLICIT_STAGES + 1, 2))
+        k[0] = rate(t0, y0)
+        for s in range(1, EXPLICIT_STAGES):
+            k[s] = rate(t0 + EXPLICIT_C[s] * h, y0 + h * (EXPLICIT_A[s, :s] @ k[:s]))
+        y1 = y0 + h * (EXPLICIT_B @ k[:EXPLICIT_STAGES])
+        k[EXPLICIT_STAGES] = rate(t0 + h, y1)
+        return y1, h * (EXPLICIT_E5 @ k), h * (EXPLICIT_E3 @ k)
+
+    assert np.allclose(EXPLICIT_C, EXPLICIT_A.sum(axis=1), rtol=0.0, atol=1e-14)
+    t0, y0 = 0.3, np.array([1.2, 0.8])
+    steps = (0.2, 0.1, 0.05, 0.025)
+    errors, fifth, third = [], [], []
+    for h in steps:
+        y1, e5, e3 = step(t0, y0, h)
+        exact = np.array([y0[0] * math.exp(math.sin(t0 + h) - math.sin(t0)), 1.0 / (1.0 / y0[1] - h)])
+        errors.append(np.max(np.abs(y1 - exact)))
+        fifth.append(np.max(np.abs(e5)))
+        third.append(np.max(np.abs(e3)))
+    # The eighth-order step reaches the rounding below h ~ 0.05 (4e-14 at h = 0.1), so its
+    # order shows on the first halving only, approached from above (9.8 there).
+    assert 8.5 < math.log2(errors[0] / errors[1]) < 10.5 and errors[1] > 100 * np.finfo(float).eps
+    for values, order in ((fifth[1:], 6), (third[1:], 4)):
+        slopes = np.log2(np.array(values[:-1]) / np.array(values[1:]))
+        assert np.all(np.abs(slopes - order) < 0.3), (order, slopes)
+
+
 @pytest.mark.parametrize("model, formulation", [("A", 0), ("B", 0), ("C", 0), ("C", 1)])
 def test_a_flight_above_the_plates_reach_steps_past_the_cap_and_lands_where_the_reference_does(model, formulation):
     """Launched from a crest by a plate at A omega^2 = 12.8 g, the block flies 11-20 plate
