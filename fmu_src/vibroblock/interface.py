@@ -21,7 +21,8 @@ OUTPUTS = {
                        "tangential spring force -k_t F along the plate's tangent, 0 out of contact"),
     "normal_force": ("Real", "m_0 delta_0/tau_0^2", "normal contact force k_n delta - gamma_n u_n, 0 out of contact"),
     "contact": ("Boolean", "", "block penetrates the plate (delta > 0)"),
-    "slip_count": ("Integer", "", "Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since the start"),
+    "slip_count": ("Integer", "", "Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since the start; "
+                   "of a cascade of resets before a detachment, as many as the integrator resolves"),
     "phi_integral": ("Real", "delta_0^2/tau_0", "integral of (vx - V_d)^2 dt since the start"),
     "penetration": ("Real", "delta_0", "penetration delta along the surface normal, > 0 in contact: (Z_p - z) cos(alpha) "
                     "(formulation 0), P(t) - zeta (formulation 1, zeta the block's normal coordinate)"),
