@@ -240,6 +240,14 @@ def _advance_clock(drv, clk, du, whole_periods):
 
 
 @njit(inline="always")
+def _moved_origin(shift, t_base, done, u_end, last_reset):
+    """The call's local times after its origin moves forward by ``shift`` (the local
+    time u there becomes 0): the origin's absolute time, the time covered before it, the
+    call's end and the last reset, in that order."""
+    return t_base + shift, done + shift, u_end - shift, last_reset - shift
+
+
+@njit(inline="always")
 def _plate(drv, clk, u):
     """Plate height and velocity at local time u after the clock's origin (``_clock``)."""
     phase = clk[0] + drv[D_OMEGA] * u
@@ -1122,10 +1130,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
             # Move the clock's origin here, so that the plate's phase omega u never
             # carries the rounding of a long local time (REBASE_CYCLES).
             _advance_clock(drv, clk, u, False)
-            t_base += u
-            done += u
-            u_end -= u
-            last_reset -= u
+            t_base, done, u_end, last_reset = _moved_origin(u, t_base, done, u_end, last_reset)
             strobe_next -= u
             u = 0.0
             t_abs = t_base
@@ -1149,10 +1154,7 @@ def _evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 # Whole periods: the plate's phase at the landing is the try's, exactly.
                 _advance_clock(drv, try_clk, u_jumped, True)
                 clk[0], clk[1] = try_clk[0], try_clk[1]
-                t_base += u + u_jumped
-                done += u + u_jumped
-                u_end -= u + u_jumped
-                last_reset -= u + u_jumped
+                t_base, done, u_end, last_reset = _moved_origin(u + u_jumped, t_base, done, u_end, last_reset)
                 u = 0.0
                 phi, phi_c = kahan_add(phi, phi_c, dq[0])
                 work_sum += dq[1]

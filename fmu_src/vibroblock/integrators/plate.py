@@ -47,6 +47,13 @@ def _exact_product(a, b):
 
 
 @njit(inline="always")
+def _below_one_turn(reduced):
+    """A reduced phase in [0, 2 pi): one a rounding short of a whole turn (a phase of
+    -1e-17, or a product a hair below k 2 pi) rounds to 2 pi itself, which is 0."""
+    return reduced if reduced < TWO_PI else 0.0
+
+
+@njit(inline="always")
 def drive_phase(drv, cnt, n):
     """The drive's phase at grid step n, in [0, 2 pi)."""
     return grid_phase(drv, cnt[C_PHASE_STEP], n)
@@ -61,7 +68,7 @@ def grid_phase(drv, anchor, n):
     whole, whole_tail = _exact_product(turns, TWO_PI)
     # rise - whole is exact (the two agree to within a few 2 pi; Sterbenz).
     phase = ((rise - whole) + (rise_tail - whole_tail) - turns * TWO_PI_TAIL) + drv[D_PHASE]
-    return phase - TWO_PI * math.floor(phase / TWO_PI)
+    return _below_one_turn(phase - TWO_PI * math.floor(phase / TWO_PI))
 
 
 def reduced_phase(phase, rate, elapsed):
@@ -70,7 +77,8 @@ def reduced_phase(phase, rate, elapsed):
     # Python numbers only: numpy's fixed-width integers overflow inside Fraction.
     elapsed = int(elapsed) if isinstance(elapsed, numbers.Integral) else float(elapsed)
     exact = Fraction(float(phase)) + Fraction(float(rate)) * Fraction(elapsed)
-    return float(exact - TWO_PI_EXACT * math.floor(exact / TWO_PI_EXACT))
+    reduced = float(exact - TWO_PI_EXACT * math.floor(exact / TWO_PI_EXACT))
+    return reduced if reduced < TWO_PI else 0.0  # as ``_below_one_turn``
 
 
 @njit(inline="always")

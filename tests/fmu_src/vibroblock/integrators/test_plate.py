@@ -43,3 +43,23 @@ def test_reduced_phase_is_exact_for_large_products():
             value = reduced_phase(*arguments)
             assert 0.0 <= value < 2 * math.pi
             assert abs(value - expected) < 1e-15
+
+
+def test_a_whole_number_of_turns_is_phase_zero_not_two_pi():
+    # omega dt = 2 pi / k rounded: at whole periods the product falls a rounding short of
+    # (or just past) k' 2 pi; the reduced phase must still lie in [0, 2 pi).
+    drv, cnt = np.zeros(L.N_DRV), np.zeros(L.N_CNT, dtype=np.int64)
+    drv[L.D_DT] = 1e-3
+    short_of_a_turn = 0
+    for k in range(1, 60):
+        drv[L.D_OMEGA] = 2 * math.pi / (k * drv[L.D_DT])
+        rate = drv[L.D_OMEGA] * drv[L.D_DT]
+        for n in range(k, 40 * k, k):
+            phase = drive_phase(drv, cnt, n)
+            assert 0.0 <= phase < 2 * math.pi
+            distance = abs(Fraction(phase) - exact(0.0, rate, n))
+            assert float(min(distance, TURN - distance)) < 1e-15
+            short_of_a_turn += exact(0.0, rate, n) > TURN / 2
+    assert short_of_a_turn > 0  # the case the reduction has to fold back to 0 did occur
+    # The same in Python, where the drive's phase is set.
+    assert reduced_phase(-1e-300, 1.0, 0.0) == 0.0
