@@ -26,6 +26,8 @@ GRID_TOLERANCE = 1e-6
 # request beyond it (e.g. a horizon of 1e9 at dt = 4e-4: 2.5e12 steps, hours) is refused
 # with its cost and the ways around it instead of holding the host.
 STEP_BUDGET_PER_CALL = 2**36
+# An fmi2Integer is a C int: a count output is held at its largest value beyond it.
+FMI_INTEGER_MAX = 2**31 - 1
 # The outputs that are plain entries of the observation in every reading: a native front
 # end may read them without Python (vibroblock.native; _observables is the reference).
 # The Boolean contact and the Integer slip_count are stored as 0.0/1.0 and a whole count;
@@ -346,6 +348,9 @@ class Block:
                 "energy_dissipated": float(obs[L.O_DISSIPATED]),
                 "energy_residual": float(residual),
             }
+            counters = self.counters
+            self._observed.update({name: min(counters[key], FMI_INTEGER_MAX)
+                                   for name, key in interface.COST_OUTPUTS.items()})
             self._observed_time = self.time
         return self._observed
 

@@ -33,7 +33,22 @@ OUTPUTS = {
                           "friction resets since the start (with energy_balance)"),
     "energy_residual": ("Real", "m_0 delta_0^2/tau_0^2", "stored energy change - work + dissipated: zero for the "
                         "exact dynamics, the integration error otherwise (with energy_balance)"),
+    # The adaptive integrator's cost since the start (0 for the other integrators, whose
+    # steps are the grid's, (t - t0) / dt).  An fmi2Integer has 32 bits: held at its
+    # largest value beyond it.
+    "accepted_steps": ("Integer", "", "internal steps the adaptive integrator accepted since the start"),
+    "rejected_steps": ("Integer", "", "internal steps the adaptive integrator rejected since the start (error "
+                       "test failed, or a step past the plate's cap retaken)"),
+    "located_events": ("Integer", "", "switches the adaptive integrator located since the start (contact, "
+                       "detachment, Coulomb reset, zero of N)"),
+    "jacobian_evaluations": ("Integer", "", "Jacobians the adaptive integrator evaluated since the start "
+                             "(RODAS4's linearisations)"),
+    "periods_jumped": ("Integer", "", "plate periods the adaptive integrator crossed by stroboscopic jumps since "
+                       "the start"),
 }
+# The outputs that count the integrator's work (``Block.counters``' keys).
+COST_OUTPUTS = {"accepted_steps": "accepted", "rejected_steps": "rejected", "located_events": "events",
+                "jacobian_evaluations": "jacobians", "periods_jumped": "periods_jumped"}
 INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
 ENERGY_BALANCE = "account work, dissipation and stored energy (outputs work_input, energy_dissipated, " \
     "energy_residual; about a third more time per step)"

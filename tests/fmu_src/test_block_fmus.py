@@ -86,6 +86,56 @@ def test_simulate_fmu_equals_the_core(fmu_path, model):
         np.testing.assert_array_equal(result[name], [row[name] for row in expected], err_msg=name)
 
 
+COST_OUTPUTS = {"accepted_steps": "accepted", "rejected_steps": "rejected", "located_events": "events",
+                "jacobian_evaluations": "jacobians", "periods_jumped": "periods_jumped"}
+CREST_X = 0.5 * math.pi / 0.02  # a crest of the paper's corrugation (slope 0)
+VALLEY_X = (-0.5 * math.pi + 0.005) / 0.02  # slope 0.1 near a valley
+
+
+def cost_run(fmu_path, model, settings, start_time, stops):
+    """The cost outputs read through the FMU after each stop, and the core's counters after
+    the same advances."""
+    from harness.cosim.fmu import FmuInstance
+    names = list(COST_OUTPUTS)
+    with FmuInstance(fmu_path(model)) as fmu:
+        fmu.start(settings, start_time)
+        read = fmu.reader(names)
+        got, t = [], start_time
+        for stop in stops:
+            fmu.do_step(t, stop - t)
+            t = stop
+            got.append(dict(zip(names, read())))
+    block = Block(model, **settings)
+    block.start(start_time)
+    expected = []
+    for stop in stops:
+        block.advance_to(stop)
+        expected.append({name: float(block.counters[key]) for name, key in COST_OUTPUTS.items()})
+    return got, expected
+
+
+def test_the_fmus_report_what_the_adaptive_integrator_counted(fmu_path):
+    # Coulomb resets from the start (the drive spring stretched by 40): events, rejections.
+    resets = dict(SCALED, integrator=4, rtol=1e-6, atol=1e-8, dt=1e-2, initial_state=0, x_start=VALLEY_X - 40.0)
+    got, expected = cost_run(fmu_path, "B", resets, 0.0, [50.0, 150.0])
+    assert got == expected
+    assert all(got[-1][name] > got[0][name] > 0 for name in ("accepted_steps", "rejected_steps", "located_events"))
+    assert got[-1]["jacobian_evaluations"] >= 1 and got[-1]["periods_jumped"] == 0
+    # Held at a crest at the paper's parameters on a plate vibrated at a third of the onset:
+    # its periods crossed by stroboscopic jumps.
+    from vibroblock import detachment_amplitude
+    omega = 0.316
+    held = dict(integrator=4, rtol=1e-6, atol=1e-8, dt=1.0, initial_state=2, formulation=1, x_start=CREST_X,
+                omega=omega, A=float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0)
+    t0 = CREST_X / 2e-4  # the drive spring relaxed (the paper's V_d)
+    got, expected = cost_run(fmu_path, "C", held, t0, [t0 + 2e4])
+    assert got == expected
+    assert got[0]["periods_jumped"] > 500 and got[0]["located_events"] == 0
+    # The fixed-step integrators count nothing of this.
+    got, _ = cost_run(fmu_path, "B", dict(resets, integrator=0, dt=1e-3), 0.0, [50.0])
+    assert set(got[0].values()) == {0.0}
+
+
 def test_communication_step_does_not_change_the_trajectory(fmu_path):
     settings = {**SCALED, "A": 1.2, "omega": 1.1, "initial_state": 2}  # bouncing: chaotic, a strict check
     runs = {h: simulate_fmu(fmu_path("A"), stop_time=300.0, output_interval=h, start_values=settings)

@@ -158,3 +158,16 @@ def test_advancing_to_a_bad_time_is_refused(t_end):
     block.start()
     with pytest.raises(ModelError, match="end time"):
         block.advance_to(t_end)
+
+
+def test_a_cost_count_beyond_an_fmi2integer_is_held_at_its_largest_value():
+    from vibroblock import layout as L
+    block = Block("C", "adaptive", rtol=1e-6, atol=1e-8, dt=1e-2, A=0.2, omega=0.8, initial_state=2)
+    block.start()
+    block.advance_to(1.0)
+    accepted = block.counters["accepted"]
+    assert block.output("accepted_steps") == accepted > 0
+    block.cnt[L.C_ACCEPTED] = 2**40  # ~1e12 steps: a long enough run gets there
+    block.advance_to(2.0)
+    assert block.counters["accepted"] > 2**40
+    assert block.output("accepted_steps") == 2**31 - 1

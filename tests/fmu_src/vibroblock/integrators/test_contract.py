@@ -12,6 +12,7 @@ from vibroblock import Block
 from vibroblock import layout as L
 from vibroblock.integrators import BY_ID, INTEGRATOR_RECORDS, REDUCED_SCENE
 from vibroblock.models import VARIANTS
+from vibroblock.interface import COST_OUTPUTS
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 VIBRATED = {"A": 0.6, "omega": 1.3, "initial_state": 2}
@@ -90,7 +91,8 @@ def test_rule_3_any_split_of_a_run_gives_the_same_result(record, model, keywords
         # for adaptive (rtol 1e-10 here) up to ~1e2 rtol across the run's landings and resets.
         bound = 1e2 * tight.get("rtol", 1e-11)
         for name, value in one.items():
-            assert many[name] == pytest.approx(value, rel=bound, abs=bound), name
+            if name not in COST_OUTPUTS:  # the cost, unlike the result, depends on the split
+                assert many[name] == pytest.approx(value, rel=bound, abs=bound), name
 
 
 @pytest.mark.parametrize("t0", [2.0**31, 2.0**40])
