@@ -33,10 +33,15 @@ COST_OUTPUTS = ("accepted_steps", "rejected_steps", "located_events")
 COMMUNICATION_STEP = 10.0
 
 
+def start_values(scenario, parameters):
+    """The FMU parameters of a scene run with an integrator's ``parameters``."""
+    return {**scenario.parameters, **parameters, "initial_state": scenario.initial, "x_start": scenario.x_start,
+            "formulation": scenario.formulation}
+
+
 def fmu_run(instance, scenario, parameters):
     """(seconds of doSteps, {x, z, phi}, cost outputs) of one run through the FMU."""
-    instance.start({**scenario.parameters, **parameters, "initial_state": scenario.initial,
-                    "x_start": scenario.x_start, "formulation": scenario.formulation})
+    instance.start(start_values(scenario, parameters))
     read = instance.reader(["x", "z", "phi_integral", *COST_OUTPUTS])
     t = 0.0
     started = time.perf_counter()
@@ -60,8 +65,7 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockC.fmu", scenarios=("C sti
             scenario = next(s for s in SCENARIOS if s.name == name)
             _, reference = scipy_run(scenario, Solver.reference(1e-12))
             for integrator in INTEGRATORS.values():  # each kernel loads once, outside the timing
-                instance.start({**scenario.parameters, "integrator": integrator, "initial_state": scenario.initial,
-                                "x_start": scenario.x_start})
+                instance.start(start_values(scenario, {"integrator": integrator}))
                 instance.do_step(0.0, 1.0)
             rows = []
             for integrator, settings in SETTINGS.items():
