@@ -74,12 +74,14 @@ class Block:
     energy_balance = property(lambda self: self.settings.energy_balance)
     scene = property(lambda self: self.settings.scene)
     readings = property(lambda self: self.settings.readings)
+    options = property(lambda self: self.settings.options)
 
     def set_parameter(self, name: str, value: float) -> None:
         """Set a parameter; during a run only A and omega, which retune the drive.  A
         retuned drive is checked with the rest of the settings (e.g. event_driven refuses
         an undamped contact driven at its own resonance) and on refusal the previous value
-        is kept."""
+        is kept.  Where the retuned drive changes what runs (adaptive's exact flows on
+        model A stop where event_driven cannot run), the kernels are bound anew."""
         previous = self.parameters.get(name)
         self.settings.set_parameter(name, value)
         if self.started:
@@ -89,6 +91,8 @@ class Block:
                 self.parameters[name] = previous
                 raise
             self._retune_drive()
+            if self.settings.kernel(self.frozen_released) is not self._kernel:
+                self._bind_kernels()
 
     def set_integrator(self, integrator: str | int) -> None:
         self.settings.set_integrator(integrator)
@@ -104,6 +108,9 @@ class Block:
 
     def set_scene_option(self, name: str, enabled: bool) -> None:
         self.settings.set_scene_option(name, enabled)
+
+    def set_integrator_option(self, name: str, enabled: bool) -> None:
+        self.settings.set_integrator_option(name, enabled)
 
     # ------------------------------------------------------------------ native front end
     time = property(lambda self: self._native.time, lambda self, t: setattr(self._native, "time", t),

@@ -4,7 +4,7 @@ The README's interface table is this module's output; a test keeps the two equal
 """
 from .integrators import INTEGRATOR_RECORDS, INTEGRATORS
 from .models import VARIANTS, offered_by
-from .parameters import INITIAL_STATES, READINGS, SCENE_OPTIONS
+from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS
 
 INPUTS = {
     "plate_z": ("delta_0", "external plate height, added to the internal drive"),
@@ -33,18 +33,20 @@ OUTPUTS = {
                           "friction resets since the start (with energy_balance)"),
     "energy_residual": ("Real", "m_0 delta_0^2/tau_0^2", "stored energy change - work + dissipated: zero for the "
                         "exact dynamics, the integration error otherwise (with energy_balance)"),
-    # The adaptive integrator's cost since the start (0 for the other integrators, whose
-    # steps are the grid's, (t - t0) / dt).  An fmi2Integer has 32 bits: held at its
-    # largest value beyond it.
-    "accepted_steps": ("Integer", "", "internal steps the adaptive integrator accepted since the start"),
+    # The cost since the start of the integrators that are not fixed-step (0 for the
+    # fixed-step ones, whose steps are the grid's, (t - t0) / dt).  An fmi2Integer has 32
+    # bits: held at its largest value beyond it.
+    "accepted_steps": ("Integer", "", "internal steps the adaptive integrator accepted since the start (none "
+                       "where it takes exact flows, exact_flows on model A)"),
     "rejected_steps": ("Integer", "", "internal steps the adaptive integrator rejected since the start (error "
                        "test failed, or a step past the plate's cap retaken)"),
-    "located_events": ("Integer", "", "switches the adaptive integrator located since the start (contact, "
-                       "detachment, Coulomb reset, zero of N)"),
+    "located_events": ("Integer", "", "switches the adaptive or event_driven integrator located since the start "
+                       "(contact, detachment, Coulomb reset, zero of N)"),
     "jacobian_evaluations": ("Integer", "", "Jacobians the adaptive integrator evaluated since the start "
                              "(RODAS4's linearisations)"),
-    "periods_jumped": ("Integer", "", "plate periods the adaptive integrator crossed by stroboscopic jumps since "
-                       "the start"),
+    "periods_jumped": ("Integer", "", "plate periods crossed since the start by the adaptive integrator's "
+                       "stroboscopic jumps, or skipped by the exact flows (event_driven, adaptive on model A) once "
+                       "the motion is periodic"),
 }
 # The outputs that count the integrator's work (``Block.counters``' keys).
 COST_OUTPUTS = {"accepted_steps": "accepted", "rejected_steps": "rejected", "located_events": "events",
@@ -92,6 +94,9 @@ def markdown_table() -> str:
         rows.append(f"| `{p.name}` | {kind} | {_models_column(sorted(defaults))} | {p.unit} | {default} | "
                     f"{p.description} |")
     rows.append(f"| `integrator` | parameter (Integer) | {every} | | 0 | {INTEGRATOR_CHOICES} |")
+    for name, (models, default, text) in INTEGRATOR_OPTIONS.items():
+        rows.append(f"| `{name}` | parameter (Boolean) | {_models_column(offered_by(models))} | | "
+                    f"{str(default).lower()} | {text} |")
     rows.append(f"| `initial_state` | parameter (Integer) | {every} | | 0 | {INITIAL_CHOICES} |")
     for name, (models, _) in READINGS.items():
         rows.append(f"| `{name}` | parameter (Integer) | {_models_column(offered_by(models))} | | 0 | "

@@ -40,7 +40,8 @@ N_Y = 11
 # last re-anchored (omega is tunable; the phase stays continuous when it changes), and
 # the cost counters of the integrators: located events (contact, detachment, reset),
 # rejected trial steps, and of an error-controlled integrator its accepted internal
-# steps and Jacobian evaluations, and the plate periods it crossed by stroboscopic jumps.
+# steps and Jacobian evaluations, and the plate periods crossed by stroboscopic jumps or
+# skipped on a periodic orbit.
 C_STEP, C_SLIPS, C_PHASE_STEP, C_EVENTS, C_REJECTED, C_ACCEPTED, C_JACOBIANS, C_JUMPED = range(8)
 N_CNT = 8
 

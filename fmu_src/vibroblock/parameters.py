@@ -8,7 +8,7 @@ loads nothing but the standard library.
 
 Units follow the paper (Sec. II C): m = g = k_n = 1, lengths in delta_0 = m g / k_n,
 times in tau_0 = sqrt(m / k_n).  Physical parameters are Real; the switches (integrator, initial state, readings,
-scene options) are Integer or Boolean.
+scene options, integrator options) are Integer or Boolean.
 """
 from __future__ import annotations
 
@@ -93,6 +93,16 @@ SCENE_OPTIONS = {
                         "orbit would lose contact (A >= A_c(omega))"),
     "coulomb_friction": (ALL_VARIANTS, "plain Coulomb friction instead of the history-dependent spring: stuck while the "
                          "needed tangential force stays below mu_s N, else sliding against mu_s N (drops k_t, F)"),
+}
+
+# Options of an integrator: Boolean parameters, fixed before initialization; name ->
+# (variants that offer it, default, description).  One table for the FMU variables, the
+# core's validation and the README.
+INTEGRATOR_OPTIONS = {
+    "exact_flows": ("A", True, "adaptive on model A, whose every regime is linear: take each regime by its exact "
+                    "flow (event_driven's closed forms and event search; rtol, atol and max_jump unused) wherever "
+                    "event_driven runs the reading and the parameters; false: error-controlled steps as on models "
+                    "B and C"),
 }
 
 INITIAL_STATES = {

@@ -1,6 +1,6 @@
-"""Checked settings of one block: model variant, parameters, integrator, initial state,
-readings of the paper (formulation, Coulomb bound, flight), energy balance and scene
-reductions.
+"""Checked settings of one block: model variant, parameters, integrator and its options,
+initial state, readings of the paper (formulation, Coulomb bound, flight), energy balance
+and scene reductions.
 
 Every value is checked when it is set (``ModelError`` says which value and why), and the
 settings are checked together (``check``) before a run starts; once a run has started
@@ -14,7 +14,7 @@ import numpy as np
 
 from .integrators import INTEGRATORS, REDUCED_SCENE, Integrator, integrator as integrator_record
 from .models import offered_by, variant
-from .parameters import INITIAL_STATES, READINGS, SCENE_OPTIONS, reading_names
+from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS, reading_names
 from .readings import encode
 from .scenes import COULOMB, FROZEN, RIGID
 
@@ -47,12 +47,15 @@ class Settings:
         self.energy_balance = False
         self.scene = {name: False for name in SCENE_OPTIONS}
         self.readings = {name: 0 for name in READINGS}
+        self.options = {name: default for name, (_, default, _) in INTEGRATOR_OPTIONS.items()}
         self.set_integrator(integrator)
         self.set_initial_state(initial_state)
         self.set_energy_balance(energy_balance)
-        for name, value in parameters.items():  # scene options and readings come as keywords
+        for name, value in parameters.items():  # scene options, readings and options come as keywords
             if name in SCENE_OPTIONS:
                 self.set_scene_option(name, value)
+            elif name in INTEGRATOR_OPTIONS:
+                self.set_integrator_option(name, value)
             elif name in READINGS:
                 self.set_reading(name, value)
             else:
@@ -103,6 +106,21 @@ class Settings:
         self._require_unlocked(name)
         self.scene[name] = bool(enabled)
 
+    def set_integrator_option(self, name: str, enabled: bool) -> None:
+        """Set an option of the integrator (``parameters.INTEGRATOR_OPTIONS``); a variant that
+        does not offer it keeps its default."""
+        if name not in INTEGRATOR_OPTIONS:
+            raise ModelError(f"unknown integrator option {name!r}; choose one of {sorted(INTEGRATOR_OPTIONS)}")
+        models, default, _ = INTEGRATOR_OPTIONS[name]
+        if not isinstance(enabled, (bool, np.bool_, int, np.integer)):
+            raise ModelError(f"{name} = {enabled!r} is not admissible: it must be true or false")
+        offered = offered_by(models)
+        if bool(enabled) != default and self.model not in offered:
+            raise ModelError(f"{name} is an option of model{'s' if len(offered) > 1 else ''} {', '.join(offered)} "
+                             f"only, not of model {self.model} ({INTEGRATOR_OPTIONS[name][2]})")
+        self._require_unlocked(name)
+        self.options[name] = bool(enabled)
+
     def set_reading(self, name: str, value: int | str) -> None:
         """Choose a reading of the paper (``parameters.READINGS``: formulation,
         coulomb_normal, flight), by its Integer value or its name."""
@@ -152,8 +170,13 @@ class Settings:
 
     def kernel(self, frozen_released: bool = False) -> Integrator:
         """The integrator that runs now: the reduced scene's scheme while reductions are in
-        effect, else the chosen integrator."""
-        return REDUCED_SCENE if self.scene_flags(frozen_released) else integrator_record(self.integrator)
+        effect, else the chosen integrator, or the exact flows it hands over to (option
+        exact_flows)."""
+        if self.scene_flags(frozen_released):
+            return REDUCED_SCENE
+        record = integrator_record(self.integrator)
+        exact = record.hand_over(self.model, self.readings, self.parameters) if self.options["exact_flows"] else None
+        return exact or record
 
     def check(self, frozen_released: bool = False) -> None:
         """Refuse settings that cannot run together (e.g. a dt the integrator cannot resolve)."""
@@ -215,9 +238,10 @@ class Settings:
     def to_dict(self) -> dict:
         return {"model": self.model, "integrator": self.integrator, "initial_state": self.initial_state,
                 "energy_balance": self.energy_balance, "scene": dict(self.scene),
-                "readings": dict(self.readings), "parameters": dict(self.parameters)}
+                "readings": dict(self.readings), "options": dict(self.options), "parameters": dict(self.parameters)}
 
     @classmethod
     def from_dict(cls, data: dict) -> "Settings":
         return cls(data["model"], data["integrator"], data["initial_state"], data["energy_balance"],
-                   **data["parameters"], **data.get("scene", {}), **data.get("readings", {}))
+                   **data["parameters"], **data.get("scene", {}), **data.get("readings", {}),
+                   **data.get("options", {}))

@@ -23,7 +23,7 @@ from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .integrators import INTEGRATORS
 from .models import offered_by, variant
 from .native import NativeStep
-from .parameters import READINGS, SCENE_OPTIONS
+from .parameters import INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS
 from .settings import ModelError
 
 
@@ -64,6 +64,12 @@ class BlockFacade(FmuFacade):
             description=f"internal integrator: {INTEGRATOR_CHOICES}",
             getter=lambda: INTEGRATORS[self.block.integrator],
             setter=lambda value: self._guard(self.block.set_integrator, int(value))))
+        for name, (models, _, text) in INTEGRATOR_OPTIONS.items():  # only the options this model offers
+            if self.model in offered_by(models):
+                self.register_variable(Boolean(
+                    name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed, description=text,
+                    getter=lambda name=name: self.block.options[name],
+                    setter=lambda value, name=name: self._guard(self.block.set_integrator_option, name, bool(value))))
         self.register_variable(Integer(
             "initial_state", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=f"initial state: {INITIAL_CHOICES}",
@@ -182,7 +188,8 @@ class BlockFacade(FmuFacade):
     def _restore(self, state: dict) -> None:
         try:
             block = Block(self.model, state["integrator"], state["initial_state"], state["energy_balance"],
-                          **state["parameters"], **state.get("scene", {}), **state.get("readings", {}))
+                          **state["parameters"], **state.get("scene", {}), **state.get("readings", {}),
+                          **state.get("options", {}))
             if state["block"] is not None:
                 block.set_state(state["block"])
             plate_input = {name: float(state["plate_input"][name]) for name in INPUTS}

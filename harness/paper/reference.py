@@ -397,9 +397,11 @@ def initial_state(model: Model, mode: int = 0, x_start=0.0, z_start=0.0, vx_star
     else:
         weight = p["m"] * p["g"] * cos_a
     w = p["omega"]
-    # steady in-contact response: y'' m + gamma_n y' + k_n y = -weight + m A w^2 sin(w t),
-    # y = -weight / k_n + Im(c e^(i w t))
-    c = p["m"] * p["A"] * w * w / (p["k_n"] - p["m"] * w * w + 1j * p["gamma_n"] * w)
+    if mode == 2:
+        # steady in-contact response: y'' m + gamma_n y' + k_n y = -weight + m A w^2 sin(w t),
+        # y = -weight / k_n + Im(c e^(i w t)) (none for an undamped contact driven at resonance:
+        # only this start needs it)
+        c = p["m"] * p["A"] * w * w / (p["k_n"] - p["m"] * w * w + 1j * p["gamma_n"] * w)
     s = np.zeros(len(STATE_NAMES))
     s[IX], s[IVX] = x_start, vx_start
     if model.tangent:

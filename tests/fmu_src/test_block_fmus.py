@@ -136,6 +136,29 @@ def test_the_fmus_report_what_the_adaptive_integrator_counted(fmu_path):
     assert set(got[0].values()) == {0.0}
 
 
+def test_block_a_takes_exact_flows_with_adaptive_unless_told_otherwise(fmu_path):
+    """Only BlockA offers exact_flows.  On (the default) its adaptive run is event_driven's:
+    the same outputs bit for bit, no steps, the events counted; off, adaptive's own steps,
+    which agree with it to the tolerance."""
+    for model in "ABC":
+        names = {v.name for v in read_model_description(fmu_path(model)).modelVariables}
+        assert ("exact_flows" in names) == (model == "A"), model
+    stick_slip = dict(SCALED, rtol=1e-10, atol=1e-12, dt=1e-2, initial_state=0, x_start=-40.0)
+    results = ["x", "z", "vx", "phi_integral", "slip_count"]
+    runs = {name: simulate_fmu(fmu_path("A"), stop_time=300.0, output_interval=100.0, start_values=settings,
+                               output=results + list(COST_OUTPUTS))
+            for name, settings in (("exact", dict(stick_slip, integrator=4)),
+                                   ("event_driven", dict(stick_slip, integrator=2)),
+                                   ("steps", dict(stick_slip, integrator=4, exact_flows=False)))}
+    exact, event_driven, steps = runs["exact"][-1], runs["event_driven"][-1], runs["steps"][-1]
+    assert [exact[name] for name in results] == [event_driven[name] for name in results]
+    assert exact["accepted_steps"] == exact["jacobian_evaluations"] == 0
+    assert exact["located_events"] == event_driven["located_events"] == exact["slip_count"] > 0
+    assert steps["accepted_steps"] > 1000 and steps["slip_count"] == exact["slip_count"]
+    for name in ("x", "vx", "phi_integral"):
+        assert abs(steps[name] - exact[name]) < 1e-8 * max(1.0, abs(exact[name])), name
+
+
 def test_communication_step_does_not_change_the_trajectory(fmu_path):
     settings = {**SCALED, "A": 1.2, "omega": 1.1, "initial_state": 2}  # bouncing: chaotic, a strict check
     runs = {h: simulate_fmu(fmu_path("A"), stop_time=300.0, output_interval=h, start_values=settings)

@@ -1,5 +1,10 @@
 """``adaptive`` (id 4, every model and reading): error-controlled, stiff-stable steps with located events.
 
+On model A, whose every regime is linear, the registry hands a run over to the exact flows
+of ``event_driven`` instead (option ``exact_flows``, on by default; where event_driven
+cannot run the reading or the parameters these steps run).  What follows is the method
+of models B and C, and of model A with that option off.
+
 Methods.  Two embedded pairs under one error control, chosen by stiffness.  Where the
 motion is not stiff (ringing contact and friction springs, flights, slips: the tolerance
 limits the step), DOP853: Dormand & Prince's explicit pair of order 8 with estimators of

@@ -57,6 +57,10 @@ cycles (bouncing locked to the plate), the remaining whole periods are added at 
 t += N 2 pi q / omega, x += N V_d T, and phi, work, dissipation and slips grow by N times
 their increase over one period.  A stick phase needs no skipping: the closed form
 crosses it in one segment whatever its length.
+
+Costs (contract rule 6): every located event counts in cnt[C_EVENTS], every skipped plate
+period in cnt[C_JUMPED] (the counters ``adaptive`` keeps too, which hands model A over to
+this scheme).
 """
 import cmath
 import math
@@ -67,8 +71,8 @@ from numba import njit
 
 from .fixed_step import record_observation
 from .plate import grid_phase, phase_after
-from ..layout import (C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA,
-                      D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL,
+from ..layout import (C_EVENTS, C_JUMPED, C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V,
+                      D_EXT_Z, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL,
                       Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS)
 
 # Events are located to this time (tau_0) past their true zero, or to 8 ulp of the time
@@ -602,11 +606,12 @@ def _touchdown_period(book, count, length):
 
 
 @njit(cache=True)
-def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, tol, skip_periods, out):
+def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, tol, skip_periods, out, costs):
     """Integrate model A from t0 + n_ref dt + off to t0 + n_to dt + off_to.
 
     Reads the state from y, writes the final state to out (same layout) and returns the
-    slip count, or -1 if an event search failed or the state stopped being finite.
+    slip count, or -1 if an event search failed or the state stopped being finite.  Adds
+    the events it located to costs[0] and the plate periods it skipped to costs[1].
     """
     m, grav, k_n, k_t = prm[P_M], prm[P_G], prm[P_KN], prm[P_KT]
     gam_n, gam_t, mu_s, k_d, v_d = prm[P_GN], prm[P_GT], prm[P_MUS], prm[P_KD], prm[P_VD]
@@ -875,6 +880,8 @@ def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, 
                 off -= whole * dt
 
         # Switches.
+        if event != EV_NONE:
+            costs[0] += 1
         if event == EV_DETACH:
             in_contact = False
             dissipated += half_kt * shear * shear
@@ -928,6 +935,7 @@ def _evolve(y, slips, drv, prm, anchor, n_ref, off, n_to, off_to, track_energy, 
                         e_normal += skips * (e_normal - before[T_ENORM])
                         slips += np.int64(skips) * np.int64(slips - before[T_SLIPS])
                         off += skips * period
+                        costs[1] += np.int64(skips) * np.int64(round(period / cycle))
                         whole = math.floor(off / dt)
                         n_ref += np.int64(whole)
                         off -= whole * dt
@@ -952,13 +960,16 @@ def advance_exact(y, cnt, drv, prm, n_steps, track_energy, tol, skip_periods):
     """``advance`` with its event tolerance and period skipping chosen (for tests)."""
     n = cnt[C_STEP]
     out = y.copy()
+    costs = np.zeros(2, np.int64)
     slips = _evolve(y, cnt[C_SLIPS], drv, prm, cnt[C_PHASE_STEP], n, 0.0, n + n_steps, 0.0, track_energy, tol,
-                    skip_periods, out)
+                    skip_periods, out, costs)
     if slips < 0:
         return -1
     y[:] = out
     cnt[C_STEP] = n + n_steps
     cnt[C_SLIPS] = slips
+    cnt[C_EVENTS] += costs[0]
+    cnt[C_JUMPED] += costs[1]
     return 0
 
 
@@ -970,7 +981,8 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     out = y.copy()
     slips = cnt[C_SLIPS]
     if h > 0.0:
-        slips = _evolve(y, slips, drv, prm, cnt[C_PHASE_STEP], n, 0.0, n, h, track_energy, EVENT_TOL, False, out)
+        slips = _evolve(y, slips, drv, prm, cnt[C_PHASE_STEP], n, 0.0, n, h, track_energy, EVENT_TOL, False, out,
+                        np.zeros(2, np.int64))
         if slips < 0:
             out[:] = math.nan
             slips = cnt[C_SLIPS]

@@ -35,3 +35,12 @@ def test_a_method_that_never_reaches_the_level_is_bounded_by_its_longest_run():
     assert "symplectic_euler never reached it (its best error 1.5e-04)" in line
     assert "dt 1e-06, error 1.6e-04, 5.7 s) already takes 285x adaptive's time" in line
     assert "solve_ivp DOP853 measured 0.9 s: 45x (target >= 30x)" in line
+
+
+def test_model_a_reports_adaptive_as_users_get_it_and_on_its_own_steps():
+    event_driven = [_row("event_driven", "dt 0.001", 0.001, 1e-9)]
+    exact = [_row("adaptive", "rtol 1e-06", 0.0011, 1e-9), _row("adaptive", "rtol 1e-08", 0.0012, 1e-9)]
+    own = [_row(wp.OWN_STEPS, "rtol 1e-06", 0.05, 5e-7), _row(wp.OWN_STEPS, "rtol 1e-08", 0.08, 4e-9)]
+    (line,) = wp.adaptive_targets({"A test": (event_driven + exact + own, 1e-10)})
+    assert "1.1 ms vs event_driven 1 ms (error 1.0e-09): 1.1x its time (target <= 10x)" in line
+    assert "On its own steps (exact_flows off): 50 ms, 50x; tightest (rtol 1e-08) error 4.0e-09, 80 ms" in line

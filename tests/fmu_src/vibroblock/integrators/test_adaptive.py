@@ -1,5 +1,7 @@
-"""The adaptive integrator against the independent reference, event_driven, the physics of
-a long stick, and its own tolerances."""
+"""The adaptive integrator's error-controlled steps against the independent reference,
+event_driven, the physics of a long stick, and its own tolerances.  On model A adaptive
+would hand the run over to exact flows (option exact_flows, test_exact_flows.py); here
+its own steps run on every model."""
 import math
 from collections import Counter
 
@@ -12,6 +14,11 @@ from vibroblock.interface import COST_OUTPUTS
 
 from harness.paper import reference
 from harness.paper.reference import Solver
+
+def stepped(model, **keywords):
+    """A Block of ``model`` on adaptive's own steps (model A's exact flows switched off)."""
+    return Block(model, "adaptive", **({"exact_flows": False} if model == "A" else {}), **keywords)
+
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 VALLEY_X = (-0.5 * math.pi + 0.005) / 0.02  # slope 0.1 of the paper's corrugation, near a valley
@@ -29,8 +36,8 @@ SCENARIOS = {
 
 
 def run(model, parameters, horizon, initial, x_start, **keywords):
-    block = Block(model, "adaptive", dt=1e-2, energy_balance=True, initial_state=initial, x_start=x_start,
-                  **parameters, **keywords)
+    block = stepped(model, dt=1e-2, energy_balance=True, initial_state=initial, x_start=x_start,
+                    **parameters, **keywords)
     block.start()
     block.advance_to(horizon)
     return block
@@ -146,8 +153,8 @@ def test_a_flight_above_the_plates_reach_steps_past_the_cap_and_lands_where_the_
     cap = 2.0 * math.pi / parameters["omega"] / 16.0
     assert landing - launch > 160.0 * cap  # > 10 periods: > 160 steps at the cap
     # Steps in the flight where the error control allows long ones (rtol 1e-6)...
-    block = Block(model, "adaptive", dt=1e-2, initial_state=2, x_start=x_start, rtol=1e-6, atol=1e-8, **parameters,
-                  **readings)
+    block = stepped(model, dt=1e-2, initial_state=2, x_start=x_start, rtol=1e-6, atol=1e-8, **parameters,
+                    **readings)
     block.start()
     block.advance_to(launch + 1.0)
     before = block.counters["accepted"] + block.counters["rejected"]
@@ -160,7 +167,7 @@ def test_a_flight_above_the_plates_reach_steps_past_the_cap_and_lands_where_the_
     after = landing + 2.0
     ref_after = reference.simulate(model, parameters, after, solver=Solver.reference(1e-12), initial=2,
                                    x_start=x_start, **readings)
-    block = Block(model, "adaptive", dt=1e-2, initial_state=2, x_start=x_start, **TIGHT, **parameters, **readings)
+    block = stepped(model, dt=1e-2, initial_state=2, x_start=x_start, **TIGHT, **parameters, **readings)
     block.start()
     block.advance_to(after)
     out = block.outputs()
@@ -203,8 +210,8 @@ def test_error_falls_with_rtol(model):
 def test_off_grid_outputs_come_from_a_short_integration():
     """An output between grid points equals the one of a run whose grid hits that time."""
     parameters, _, initial, x_start = scenario("B", "bouncing")
-    coarse = Block("B", "adaptive", dt=1.0, initial_state=initial, x_start=x_start, **parameters, **TIGHT)
-    fine = Block("B", "adaptive", dt=0.25, initial_state=initial, x_start=x_start, **parameters, **TIGHT)
+    coarse = stepped("B", dt=1.0, initial_state=initial, x_start=x_start, **parameters, **TIGHT)
+    fine = stepped("B", dt=0.25, initial_state=initial, x_start=x_start, **parameters, **TIGHT)
     for block in (coarse, fine):
         block.start()
         block.advance_to(12.75)
@@ -223,7 +230,7 @@ def test_a_long_stick_at_the_papers_parameters_costs_few_steps(model, keywords):
     steps of order 1 by the contact's and the spring's periods (6.3 and 11.9): 1e7-1e8
     steps.  The L-stable steps grow once the start's ringing (amplitude ~ V_S / omega) has
     died, so crossing 0.9 t_stick takes a few thousand steps."""
-    block = Block(model, "adaptive", dt=1.0, energy_balance=True, **keywords)
+    block = stepped(model, dt=1.0, energy_balance=True, **keywords)
     block.start()
     p = block.parameters
     creep = p["V_d"] * p["k_d"] / (p["k_t"] + p["k_d"])
@@ -243,13 +250,13 @@ def test_a_long_stick_at_the_papers_parameters_costs_few_steps(model, keywords):
 @pytest.mark.parametrize("name, value", [("rtol", 0.0), ("rtol", -1e-6), ("atol", 0.0), ("atol", math.nan)])
 def test_non_positive_tolerances_are_refused_when_set(name, value):
     with pytest.raises(ModelError, match=f"{name} = .* must be a finite number > 0"):
-        Block("A", "adaptive", **{name: value})
+        stepped("A", **{name: value})
 
 
 @pytest.mark.parametrize("name, value, allowed", [("rtol", 0.5, r"\[1e-13, 0.01\]"), ("rtol", 1e-16, r"\[1e-13"),
                                                   ("atol", 10.0, r"\(1e-300, 1\]")])
 def test_tolerances_out_of_range_are_refused_at_start(name, value, allowed):
-    block = Block("A", "adaptive", **{name: value})
+    block = stepped("A", **{name: value})
     with pytest.raises(ModelError, match=f"{name} = .*adaptive.*{allowed}"):
         block.start()
     Block("A", "symplectic_euler", **{name: value}).start()  # the fixed-step schemes ignore them
@@ -291,8 +298,8 @@ def test_every_reading_agrees_with_the_independent_reference(model, combination)
                              x_start=READING_X_START, **readings)
     switches = Counter(kind for _, kind in ref.event_log)
     assert switches["contact"] > 0 and switches["detach"] > 0 and ref.slips > 0, switches
-    block = Block(model, "adaptive", dt=1e-2, initial_state=2, x_start=READING_X_START, rtol=READING_RTOL,
-                  atol=1e-2 * READING_RTOL, **READING_SCENE, **readings)
+    block = stepped(model, dt=1e-2, initial_state=2, x_start=READING_X_START, rtol=READING_RTOL,
+                    atol=1e-2 * READING_RTOL, **READING_SCENE, **readings)
     block.start()
     core, slips, contact = [], [], []
     for t in times:
@@ -314,9 +321,9 @@ def test_energy_balance_closes_in_the_tangent_frame(model, coulomb_normal):
     """docs/physics.md Sec. 7's tangent-frame balance (kinetic m (u^2 + w^2)/2, E_n = k_n delta^2/2,
     the work of the normal components of load and drive on zeta) closes to the tolerance
     through resets, flights and landings; the position moving at dx/dt = u would not."""
-    block = Block(model, "adaptive", dt=1e-2, initial_state=2, x_start=READING_X_START, rtol=READING_RTOL,
-                  atol=1e-2 * READING_RTOL, energy_balance=True, formulation=1, coulomb_normal=coulomb_normal,
-                  **READING_SCENE)
+    block = stepped(model, dt=1e-2, initial_state=2, x_start=READING_X_START, rtol=READING_RTOL,
+                    atol=1e-2 * READING_RTOL, energy_balance=True, formulation=1, coulomb_normal=coulomb_normal,
+                    **READING_SCENE)
     block.start()
     residuals = []
     for t in np.linspace(2.0, READING_HORIZON, 10):
@@ -337,8 +344,8 @@ def _vibrated_stick(model, max_jump, horizon, omega=0.316, calls=1, x_start=CRES
     from vibroblock import defaults, detachment_amplitude
     p = defaults(model)
     amplitude = float(detachment_amplitude(omega, m=1.0, g=1.0, k_n=1.0, gamma_n=0.07)) / 3.0
-    block = Block(model, "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=x_start, dt=1.0,
-                  max_jump=max_jump, **keywords)
+    block = stepped(model, initial_state=2, A=amplitude, omega=omega, x_start=x_start, dt=1.0,
+                    max_jump=max_jump, **keywords)
     t0 = x_start / p["V_d"]
     block.start(t0)
     for call in range(1, calls + 1):
@@ -410,8 +417,8 @@ def test_jumps_tried_and_refused_leave_the_run_as_it_was():
     try starts from a fresh rate.)"""
     runs = {}
     for max_jump in (0.0, 1e12):
-        block = Block("C", "adaptive", initial_state=2, A=3.0, omega=0.316, x_start=CREST_X, dt=1.0,
-                      max_jump=max_jump, formulation=1, rtol=1e-6, atol=1e-8)
+        block = stepped("C", initial_state=2, A=3.0, omega=0.316, x_start=CREST_X, dt=1.0,
+                        max_jump=max_jump, formulation=1, rtol=1e-6, atol=1e-8)
         block.start()
         block.advance_to(2e4)
         runs[max_jump] = block
@@ -452,7 +459,7 @@ def test_stroboscopic_jumps_stop_before_the_slip_they_would_cross():
     moves x by ~V_d T = 0.1)."""
     parameters = dict(SCALED, A=0.5, omega=0.5)
     runs = {}
-    for name, keywords in (("event_driven", {}), ("adaptive", {})):  # adaptive at its default rtol 1e-8
+    for name, keywords in (("event_driven", {}), ("adaptive", {"exact_flows": False})):  # adaptive at rtol 1e-8
         block = Block("A", name, initial_state=2, dt=1e-2, **parameters, **keywords)
         block.start()
         slips_at, positions = [], []
@@ -469,3 +476,99 @@ def test_stroboscopic_jumps_stop_before_the_slip_they_would_cross():
     assert jumped > 0
     assert runs["adaptive"][1] == runs["event_driven"][1] and len(runs["event_driven"][1]) >= 2
     assert np.max(np.abs(runs["adaptive"][2] - runs["event_driven"][2])) <= 1e-6 * np.max(np.abs(runs["event_driven"][2]))
+
+
+# ---------------------------------------------------------------- model A: exact flows
+def _results(block):
+    return {name: value for name, value in block.outputs().items() if name not in COST_OUTPUTS}
+
+
+@pytest.mark.parametrize("name", list(SCENARIOS))
+def test_on_model_a_adaptive_takes_the_exact_flows(name):
+    """By default adaptive runs model A by event_driven's exact flows: the same results bit
+    for bit, no steps, no Jacobian, and every located event counted."""
+    parameters, horizon, initial, x_start = scenario("A", name)
+    runs = {}
+    for integrator in ("adaptive", "event_driven"):
+        block = Block("A", integrator, dt=1e-2, energy_balance=True, initial_state=initial, x_start=x_start,
+                      **parameters)
+        block.start()
+        block.advance_to(horizon)
+        runs[integrator] = block
+    assert _results(runs["adaptive"]) == _results(runs["event_driven"])
+    counters = runs["adaptive"].counters
+    assert counters["accepted"] == counters["rejected"] == counters["jacobians"] == 0
+    assert counters["events"] == runs["event_driven"].counters["events"] >= counters["resets"]
+    if name != "sub-threshold":
+        assert counters["events"] > 0
+
+
+def test_exact_flows_count_the_events_of_the_independent_reference():
+    """The events counted on model A are the reference's: on the stick-slip scenario (no
+    cascades) one per Coulomb reset; bouncing, every landing and detachment."""
+    for name, kinds in (("stick-slip", ("reset",)), ("bouncing", ("contact", "detach"))):
+        parameters, horizon, initial, x_start = scenario("A", name)
+        ref = reference.simulate("A", parameters, horizon, solver=Solver.reference(1e-12), initial=initial,
+                                 x_start=x_start)
+        block = Block("A", "adaptive", dt=1e-2, initial_state=initial, x_start=x_start, **parameters)
+        block.start()
+        block.advance_to(horizon)
+        expected = sum(1 for _, kind in ref.event_log if kind in kinds)
+        assert expected > 0
+        if name == "stick-slip":
+            assert block.counters["events"] == expected == ref.slips
+        else:  # the switches of contact, plus the resets and holds event_driven resolves
+            assert block.counters["events"] >= expected
+
+
+@pytest.mark.parametrize("case, parameters, readings", [
+    ("the applied-load bound", dict(SCALED), {"coulomb_normal": 1}),
+    ("an undamped contact driven at resonance", dict(SCALED, gamma_n=0.0, A=0.05, omega=1.0), {}),
+])
+def test_where_event_driven_cannot_run_adaptive_takes_its_own_steps(case, parameters, readings):
+    """No hand-over where event_driven refuses the reading or the parameters: adaptive's own
+    steps run, and agree with the independent reference."""
+    with pytest.raises(ModelError):
+        Block("A", "event_driven", dt=1e-2, **parameters, **readings).start()
+    block = Block("A", "adaptive", dt=1e-2, x_start=-40.0, **parameters, **readings, **TIGHT)
+    block.start()
+    block.advance_to(100.0)
+    assert block.counters["accepted"] > 0
+    ref = reference.simulate("A", parameters, 100.0, solver=Solver.reference(1e-12), x_start=-40.0, **readings)
+    assert error(block.outputs(), ref) < 1e-7
+
+
+def test_a_retuned_drive_that_event_driven_cannot_run_hands_back_to_steps():
+    """Undamped contact: exact flows while the drive is off resonance; retuned onto it, the
+    run goes on by adaptive's steps (event_driven alone refuses the retune) and agrees with
+    a run on steps throughout."""
+    parameters = dict(SCALED, gamma_n=0.0, A=0.05, omega=0.8)
+    blocks = [Block("A", "adaptive", dt=1e-2, **parameters, **TIGHT), stepped("A", dt=1e-2, **parameters, **TIGHT)]
+    for block in blocks:
+        block.start()
+        block.advance_to(50.0)
+    assert blocks[0].counters["accepted"] == 0 < blocks[1].counters["accepted"]
+    for block in blocks:
+        block.set_parameter("omega", 1.0)
+        block.advance_to(100.0)
+    assert blocks[0].counters["accepted"] > 0
+    a, b = blocks[0].outputs(), blocks[1].outputs()
+    for key in ("x", "z", "vx", "vz"):
+        assert a[key] == pytest.approx(b[key], rel=1e-7, abs=1e-8), key
+    exact = Block("A", "event_driven", dt=1e-2, **parameters)
+    exact.start()
+    with pytest.raises(ModelError, match="resonance"):
+        exact.set_parameter("omega", 1.0)
+
+
+def test_exact_flows_is_an_option_of_model_a_fixed_before_the_start():
+    with pytest.raises(ModelError, match="exact_flows is an option of model A only, not of model B"):
+        Block("B", "adaptive", exact_flows=False)
+    assert Block("C", "adaptive", exact_flows=True).options["exact_flows"]  # the default, without effect
+    block = Block("A", "adaptive", exact_flows=False)
+    block.start()
+    with pytest.raises(ModelError, match="exact_flows is fixed once the run has started"):
+        block.set_integrator_option("exact_flows", True)
+    restored = Block("A", "adaptive")
+    restored.set_state(block.get_state())
+    assert restored.options["exact_flows"] is False
