@@ -325,6 +325,7 @@ def test_do_steps_through_pythonfmu_give_the_same_bits(extracted, fmu_log, monke
 NATIVE_CASES = [
     ("A", {"A": 0.8, "omega": 0.7, "initial_state": 2}),
     ("A", {"A": 0.02, "omega": 0.5, "frozen_vertical": True}),  # A = 6 at step 40: the guard hands over
+    ("A", {**SCALED, "A": 0.8, "omega": 0.7, "initial_state": 2, "integrator": 4}),  # adaptive's exact flows
     ("B", {**SCALED, "A": 0.2, "omega": 0.7, "integrator": 4, "formulation": 1}),
     ("C", {**SCALED, "A": 0.3, "omega": 0.85, "integrator": 3}),
 ]
@@ -395,6 +396,27 @@ def test_plain_do_steps_run_without_python_and_give_the_same_bits(extracted, fmu
     assert [t for t in python_steps if t not in handover] == [*inputs[:3], refused, *inputs[3:]]
     assert len(handover) == (1 if settings.get("frozen_vertical") else 0)
     assert np.ptp(native[:, 1]) > 1e-4  # z moves: the run exercises the block
+
+
+def test_a_retune_that_ends_adaptives_exact_flows_goes_on_by_its_own_steps(extracted, fmu_log):
+    """BlockA, adaptive, undamped contact: exact flows while the drive is off resonance; set
+    onto it during the run, the doSteps go on by adaptive's own steps (event_driven has no
+    closed form there), with the core's bits after every doStep."""
+    settings = {**SCALED, "gamma_n": 0.0, "A": 0.05, "omega": 0.8, "integrator": 4, "rtol": 1e-10, "atol": 1e-12}
+    core = Block("A", **settings)
+    core.start()
+    with instance(extracted, "A", fmu_log, settings) as (slave, vr):
+        t = 0.0
+        for k in range(40):
+            if k == 20:
+                assert slave.getInteger([vr["accepted_steps"]])[0] == 0
+                assert set_real(slave, vr["omega"], 1.0) == fmi2OK
+                core.set_parameter("omega", 1.0)
+            assert do_step(slave, t, 2.5) == fmi2OK
+            t += 2.5
+            core.advance_to(t)
+            assert reals(slave, vr) == [core.output(name) for name in OUTPUTS], k
+        assert slave.getInteger([vr["accepted_steps"]])[0] == core.counters["accepted"] > 0
 
 
 def test_fixed_parameters_cannot_change_during_a_run(extracted, fmu_log):
