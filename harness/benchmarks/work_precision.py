@@ -34,9 +34,10 @@ near a valley of their corrugation):
 
 Integrators: the fixed-step ones over dt, ``event_driven`` (model A), ``adaptive`` over
 rtol (atol = rtol / 100); on model A ``adaptive`` takes event_driven's exact flows, and
-its own steps are measured beside it (``adaptive, own steps``: exact_flows off).  On B and C (not with ``--quick``) ``symplectic_euler`` goes on to
-finer steps (EULER_FINE) until it reaches the equal-accuracy level or one of its runs costs
-100x ``adaptive``'s time there, so that the target is met or missed by a measured run.
+its own steps are measured beside it (``adaptive, own steps``: exact_flows off).  On B and
+C (not with ``--quick``) ``symplectic_euler`` goes on to finer steps (EULER_FINE) until it
+reaches the equal-accuracy level or one of its runs costs 100x ``adaptive``'s time there,
+so that the target is met or missed by a measured run.
 
 Non-chaotic scenarios are compared pointwise at the end: x and phi (errors relative to
 their reference values) and z (in delta_0, the rest penetration), the error being the
@@ -49,8 +50,9 @@ event detection (sign at the step ends), i.e. what a user of solve_ivp gets.
 
 The targets (printed and written in the table), at equal accuracy: on model A event_driven
 against symplectic_euler and solve_ivp, and adaptive against event_driven (within 10x,
-agreeing to 1e-8; its own steps reported beside); on B and C adaptive against symplectic_euler (>= 100x) and against the
-fastest solve_ivp run reaching the accuracy (>= 30x).
+agreeing to 1e-8; its own steps reported beside); on B and C adaptive against
+symplectic_euler (>= 100x) and against the fastest solve_ivp run reaching the accuracy
+(>= 30x).
 """
 from __future__ import annotations
 
@@ -280,6 +282,11 @@ def ratio(numerator: float, denominator: float) -> str:
     return "n/a" if math.isinf(numerator) or denominator <= 0.0 else f"{numerator / denominator:,.0f}x"
 
 
+def share(numerator: float, denominator: float) -> str:
+    """A ratio near 1, to two digits."""
+    return "n/a" if math.isinf(numerator) or denominator <= 0.0 else f"{numerator / denominator:.2g}x"
+
+
 def adaptive_targets(results):
     """adaptive against event_driven on A; against symplectic_euler and solve_ivp on B, C."""
     lines = []
@@ -295,7 +302,7 @@ def adaptive_targets(results):
             own = sorted([r for r in rows if r[0] == OWN_STEPS], key=lambda r: r[3])[0]
             lines.append(f"- **{name}**: adaptive at {level:.0e}: {t_adaptive * 1e3:.3g} ms"
                          f"{' (extrapolated)' if ext_a else ''} vs event_driven {ed[2] * 1e3:.3g} ms (error "
-                         f"{ed[3]:.1e}): {t_adaptive / ed[2]:.2g}x its time (target <= 10x); adaptive's tightest "
+                         f"{ed[3]:.1e}): {share(t_adaptive, ed[2])} its time (target <= 10x); adaptive's tightest "
                          f"run ({tight[1]}) error {tight[3]:.1e}. On its own steps (exact_flows off): "
                          f"{t_own * 1e3:.3g} ms{' (extrapolated)' if ext_o else ''}, {ratio(t_own, ed[2])}; "
                          f"tightest ({own[1]}) error {own[3]:.1e}, {own[2] * 1e3:.3g} ms.")

@@ -258,6 +258,7 @@ _RECORDS = (
                "not stiff, stiff-stable RODAS4 where it is; on model A exact flows (option exact_flows)",
                models="*", force_evaluations=0, check_step=_tolerances, advance=adaptive.advance,
                observe=adaptive.observe, statuses=_ADAPTIVE_STATUSES, splits_bitwise=False,
+               # (_exact_flows reads the finished registry: looked up when called)
                hand_over=lambda model, readings, parameters: _exact_flows(model, readings, parameters)),
     # adaptive runs every reading: the tangent frame through position_rates, the applied-load
     # bound through coulomb_bound in its event values, free flight with one frame per regime
@@ -274,15 +275,17 @@ def _exact_flows(model: str, readings: dict, parameters: dict) -> Integrator | N
     """adaptive's hand-over on model A (its option ``exact_flows``).  Every regime of model A
     is linear with polynomial and harmonic forcing, so its exact flow is known in closed
     form; taking it costs per event, where error-controlled steps must resolve the friction
-    spring's ringing and the plate's period in between (78x event_driven's time on a
-    stick-slip run at rtol 1e-6, README "adaptive, measured").  Where event_driven cannot run
+    spring's ringing and the plate's period in between (69x event_driven's time on a
+    stick-slip run at equal accuracy 1e-6, README "adaptive, measured").  Where event_driven cannot run
     the reading (the applied-load bound) or the parameters (an undamped contact driven at
     resonance), adaptive keeps its own steps."""
     exact = INTEGRATOR_RECORDS["event_driven"]
-    if not exact.supports(model) or exact.unsupported_reading(readings) or exact.check_step(parameters, model,
-                                                                                            exact.name):
+    if (not exact.supports(model) or exact.unsupported_reading(readings)
+            or exact.check_step(parameters, model, exact.name)):
         return None
     return _ADAPTIVE_EXACT
+
+
 BY_ID: dict[int, Integrator] = {r.id: r for r in _RECORDS}
 # name -> FMU id of the integrators users choose from
 INTEGRATORS: dict[str, int] = {r.name: r.id for r in _RECORDS if r.public}

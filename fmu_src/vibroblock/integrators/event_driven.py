@@ -72,8 +72,8 @@ from numba import njit
 from .fixed_step import record_observation
 from .plate import grid_phase, phase_after
 from ..layout import (C_EVENTS, C_JUMPED, C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V,
-                      D_EXT_Z, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL,
-                      Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS)
+                      D_EXT_Z, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_MUS, P_VD, Y_DISSIPATED,
+                      Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z, N_OBS)
 
 # Events are located to this time (tau_0) past their true zero, or to 8 ulp of the time
 # since the segment began, whichever is larger.
