@@ -1,7 +1,7 @@
 """The adaptive integrator's error-controlled steps against the independent reference,
-event_driven, the physics of a long stick, and its own tolerances.  On model A adaptive
-would hand the run over to exact flows (option exact_flows, test_exact_flows.py); here
-its own steps run on every model."""
+event_driven, the physics of a long stick, and its own tolerances (on model A with its
+option exact_flows off: ``stepped``); and, last, its hand-over to event_driven's exact
+flows on model A."""
 import math
 from collections import Counter
 
@@ -14,6 +14,7 @@ from vibroblock.interface import COST_OUTPUTS
 
 from harness.paper import reference
 from harness.paper.reference import Solver
+
 
 def stepped(model, **keywords):
     """A Block of ``model`` on adaptive's own steps (model A's exact flows switched off)."""
