@@ -37,9 +37,11 @@ MAX_CHILDREN = 8
 # Runs in child processes with the core's parent folder on sys.path and one shared,
 # initially empty NUMBA_CACHE_DIR.  Every configuration a master can choose goes
 # through the same calls an FMU makes (start, inputs, advance, outputs, state): every
-# model, integrator and scene option in the default reading, and every model and
+# model, integrator and scene option in the default reading, every model and
 # integrator in each other reading of the paper (vibroblock.readings: each is a
-# kernel of its own).  A configuration the core refuses is skipped.  The work is cut
+# kernel of its own), and each integrator option that changes what runs
+# (parameters.INTEGRATOR_OPTIONS: exact_flows off runs adaptive's own steps on model A).
+# A configuration the core refuses is skipped.  The work is cut
 # into jobs that compile disjoint kernels (one model, reading and integrator each),
 # dealt out to `shares` children by their expected cost; child `share` runs its part.
 WARM_UP = r"""
@@ -48,7 +50,7 @@ import vibroblock
 from vibroblock import Block, INTEGRATORS, ModelError
 from vibroblock.native import NativeStep
 from vibroblock.models import VARIANTS, offered_by
-from vibroblock.parameters import READINGS, SCENE_OPTIONS
+from vibroblock.parameters import INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS
 
 share, shares = map(int, sys.argv[1:3])
 # Relative compile costs (adaptive kernels, RODAS4 and DOP853, take ~45 s of CPU each, a
@@ -68,7 +70,22 @@ for model in VARIANTS:
                                  if model in offered_by(models)]
                 configs = [(scene, energy, initial) for energy, scene, initial
                            in itertools.product((False, True), scenes, (0, 2))]
-            jobs.append((COST.get(integrator, 2) * (1 if any(values) else 3), model, integrator, configs))
+            cost = COST.get(integrator, 2) * (1 if any(values) else 3)
+            jobs.append((cost, model, integrator, configs))
+            # An option that changes what runs (adaptive's exact_flows on model A: its own
+            # steps instead of event_driven's flows) has kernels of its own.
+            for name, (models, default, _) in INTEGRATOR_OPTIONS.items():
+                if model not in offered_by(models):
+                    continue
+                try:
+                    as_default = Block(model, integrator, **reading).settings.kernel()
+                    changed = Block(model, integrator, **reading, **{name: not default}).settings.kernel()
+                except ModelError:
+                    continue
+                if changed is not as_default:  # (a scene reduction runs its own scheme either way)
+                    jobs.append((cost, model, integrator,
+                                 [({**options, name: not default}, energy, initial) for options, energy, initial
+                                  in configs if not set(options) & set(SCENE_OPTIONS)]))
 
 load = [0] * shares
 mine = []
