@@ -8,6 +8,7 @@ leave every value unchanged; a change of physics must re-record on purpose and s
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -24,6 +25,26 @@ INTEGRATORS = {"A": ("symplectic_euler", "rk4", "event_driven", "implicit_contac
                "B": ("symplectic_euler", "rk4", "implicit_contact"),
                "C": ("symplectic_euler", "rk4", "implicit_contact")}
 SCENES = {"rigid_contact": "ABC", "frozen_vertical": "A", "coulomb_friction": "ABC"}
+# adaptive's own error-controlled steps (on model A with its hand-over to exact flows off).
+ADAPTIVE = {"A": dict(exact_flows=False), "B": {}, "C": {}}
+# Each non-default reading, for every integrator that runs it (the others refuse it).
+READING_CASES = {
+    "formulation": ("BC", ("symplectic_euler", "rk4", "adaptive")),
+    "coulomb_normal": ("ABC", ("symplectic_euler", "rk4", "implicit_contact", "adaptive")),
+    "flight": ("BC", ("symplectic_euler", "rk4", "adaptive")),
+}
+# Long runs that take the integrators' period-skipping paths: adaptive's stroboscopic
+# jumps over a held block on a vibrated plate, event_driven's skipped periods on a locked orbit.
+LONG_STOPS = (0.0, 123.4567, 2000.0, 20000.00037)
+LONG_CASES = {  # (each skips thousands of plate periods: periods_jumped, not stored, says so)
+    "A/event_driven/locked_orbit": ("A", dict(integrator="event_driven", A=1.2, omega=1.2, initial_state=0,
+                                              x_start=3.0)),
+    # held in a trough of B's corrugation (omega_x x = -pi/2) by a soft, slow drive spring
+    "B/adaptive/held_vibrated": ("B", dict(integrator="adaptive", A=0.05, omega=2.0, initial_state=2, rtol=1e-6,
+                                           x_start=-25.0 * math.pi, k_d=1e-4, V_d=1e-5)),
+    "C/adaptive/held_vibrated": ("C", dict(integrator="adaptive", A=0.05, omega=2.0, initial_state=2, rtol=1e-6,
+                                           x_start=3.0)),
+}
 
 
 def cases():
@@ -39,6 +60,19 @@ def cases():
                 yield f"{model}/{scene}/{scenario}", model, dict(
                     integrator="symplectic_euler", energy_balance=True, dt=4e-3, x_start=3.0,
                     **{scene: True}, **SCALED, **settings)
+    for model, options in ADAPTIVE.items():
+        for scenario, settings in SCENARIOS.items():
+            yield f"{model}/adaptive/{scenario}", model, dict(
+                integrator="adaptive", energy_balance=True, dt=1e-2, x_start=3.0, **options, **SCALED, **settings)
+    for reading, (models, integrators) in READING_CASES.items():
+        for model in models:
+            for integrator in integrators:
+                dt = 1e-2 if integrator in ("adaptive", "implicit_contact") else 4e-3
+                yield f"{model}/{integrator}/{reading}", model, dict(
+                    integrator=integrator, energy_balance=True, dt=dt, x_start=3.0, **{reading: 1}, **SCALED,
+                    **SCENARIOS["bouncing"])
+    for key, (model, settings) in LONG_CASES.items():
+        yield key, model, dict(energy_balance=True, dt=1e-2, stops=LONG_STOPS, **{**SCALED, **settings})
     # External plate input held over communication steps.
     for model in "ABC":
         yield f"{model}/external", model, dict(integrator="symplectic_euler", energy_balance=False, dt=4e-3,
@@ -54,11 +88,12 @@ def run_case(model, settings):
     initial = settings.pop("initial_state", 0)
     energy = settings.pop("energy_balance")
     external = settings.pop("external_input", False)
+    stops = settings.pop("stops", STOPS)
     block = Block(model, integrator, initial, energy, **settings)
     rows = []
     try:
         block.start()
-        for i, t in enumerate(STOPS):
+        for i, t in enumerate(stops):
             if t > 0.0:
                 if external:
                     block.set_plate_input(0.01 * i, 0.02 * (-1) ** i, 0.1 * i)
