@@ -50,7 +50,9 @@ import vibroblock
 from vibroblock import Block, INTEGRATORS, ModelError
 from vibroblock.native import NativeStep
 from vibroblock.models import VARIANTS, offered_by
-from vibroblock.parameters import INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS
+from vibroblock.parameters import INTEGRATOR_OPTIONS, SCENE_OPTIONS
+from vibroblock.readings import choices
+READINGS = choices()
 
 share, shares = map(int, sys.argv[1:3])
 # Relative compile costs (adaptive kernels, RODAS4 and DOP853, take ~45 s of CPU each, a

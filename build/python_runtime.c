@@ -479,16 +479,17 @@ int python_runtime_ready(const char* fmu_root, char* error, size_t size)
 
 /* The record a Block keeps for a front end (vibroblock/native.py, NativeStep: the same
  * fields in the same order; LAYOUT there is NATIVE_LAYOUT here). */
-#define NATIVE_LAYOUT 2
+#define NATIVE_LAYOUT 3
 #define OUTPUT_SURFACE_Z (-1) /* native.SURFACE_Z: z + penetration / cos(alpha) */
 #define OUTPUT_ZERO (-2)      /* native.ZERO */
 typedef struct {
     int64_t layout;
     int64_t ready;    /* a run has started and its advance kernel is bound */
     int64_t held;     /* an input waits to be applied by the slave */
-    int64_t (*advance)(int64_t flags, double* y, int64_t* cnt, double* drv, double* prm, int64_t n_steps,
+    int64_t (*advance)(int64_t kind, int64_t flags, double* y, int64_t* cnt, double* drv, double* prm, int64_t n_steps,
                        int64_t track_energy);
     int64_t returned_ok;
+    int64_t kind;     /* the run's variant, readings and laws (vibroblock/readings.py) */
     int64_t flags;
     double* y;
     int64_t* cnt;
@@ -500,7 +501,7 @@ typedef struct {
     double t0, dt;
     double time;
     double grid_tolerance, time_tolerance;
-    int64_t (*observe)(int64_t flags, double* y, int64_t* cnt, double* drv, double* prm, double h,
+    int64_t (*observe)(int64_t kind, int64_t flags, double* y, int64_t* cnt, double* drv, double* prm, double h,
                        int64_t track_energy, double* obs);
     int64_t observed_ok;     /* what observe returns when it filled obs */
     double* obs;
@@ -542,7 +543,7 @@ int python_slave_native_step(const PythonSlave* slave, double t, double h)
     double step = (double)n->cnt[n->step_slot];
     if (!(target - step <= n->step_budget) || target >= 9.2e18) return 0;  /* (beyond int64: Python refuses) */
     if (target > step &&
-        n->advance(n->flags, n->y, n->cnt, n->drv, n->prm, (int64_t)target - (int64_t)step, n->track_energy)
+        n->advance(n->kind, n->flags, n->y, n->cnt, n->drv, n->prm, (int64_t)target - (int64_t)step, n->track_energy)
             != n->returned_ok)
         return 0;
     n->time = end;
@@ -571,7 +572,7 @@ int python_slave_native_get(const PythonSlave* slave, const unsigned int vr[], s
     double grid_time = n->t0 + (double)n->cnt[n->step_slot] * n->dt;
     double h = n->time - grid_time;
     if (h < n->grid_tolerance * n->dt) h = 0.0;  /* on the grid up to rounding of the master's time */
-    if (n->observe(n->flags, n->y, n->cnt, n->drv, n->prm, fmin(h, n->dt), n->track_energy, n->obs) !=
+    if (n->observe(n->kind, n->flags, n->y, n->cnt, n->drv, n->prm, fmin(h, n->dt), n->track_energy, n->obs) !=
         n->observed_ok)
         return 0;
     const double* obs = n->obs;

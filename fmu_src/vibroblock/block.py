@@ -15,6 +15,7 @@ from . import interface
 from . import layout as L
 from .initial_state import frame_to_point, place
 from .integrators.plate import reduced_phase
+from .laws import law
 from .native import LAYOUT, OBSERVED_OK, RETURNED_OK, SURFACE_Z, ZERO, NativeStep, entry_address
 from .settings import ModelError, Settings
 
@@ -138,14 +139,15 @@ class Block:
         if not (self._natively_driven and self.started):
             return
         settings, kernel = self.settings, self._kernel
-        entry = entry_address(kernel.advance, settings.kind, kernel.id)
+        entry = entry_address(kernel.advance, kernel.id)
         record.advance = entry
+        record.kind = settings.kind
         record.flags = settings.scene_flags(self.frozen_released)
         record.y, record.cnt, record.drv, record.prm = (a.ctypes.data for a in (self.y, self.cnt, self.drv, self.prm))
         record.track_energy = int(self._track_energy)
         record.step_budget = self._step_budget
         record.t0, record.dt = self._grid
-        record.observe = entry_address(kernel.observe, settings.kind, kernel.id)
+        record.observe = entry_address(kernel.observe, kernel.id)
         record.obs = self.obs.ctypes.data
         self._native_outputs = self._observed_outputs()
         record.outputs, record.n_outputs = self._native_outputs.ctypes.data, len(self._native_outputs)
@@ -155,7 +157,7 @@ class Block:
         """(value reference, observation slot or SURFACE_Z / ZERO) of each output a front
         end may read straight from the observation in this run."""
         sources = dict(OBSERVED_OUTPUTS)
-        if self.settings.kind == self.settings.variant.kind:  # else z, vx, vz come from _as_point
+        if not self._maps_to_point():  # else z, vx, vz come from _as_point
             sources.update(OBSERVED_POINT)
         if not self.energy_balance:
             sources["energy_residual"] = ZERO
@@ -198,13 +200,10 @@ class Block:
         self.started = True
         self._publish_native()
         self.settings.locked = True
-        # The normal spring's energy starts at k_n delta^2 / 2 and then integrates its power.
-        self._observed = None
-        penetration = self.output("penetration")
-        self.y[L.Y_E_NORMAL] = 0.5 * p["k_n"] * penetration**2 if penetration > 0.0 else 0.0
         self._observed = None
         obs = self._observe()
-        self.y[L.Y_E_START] = self._stored_energy(obs, self.y[L.Y_E_NORMAL], t0)
+        self.y[L.Y_E_NORMAL] = self._contact_energy(obs[L.O_PENETRATION])
+        self.y[L.Y_E_START] = self._stored_energy(obs, t0)
 
     def _retune_drive(self) -> None:
         """Take new A, omega from the current grid step on, keeping the phase continuous."""
@@ -319,14 +318,23 @@ class Block:
         self._observe_at(min(h, dt), self._track_energy, self.obs)
         return self.obs
 
-    def _stored_energy(self, obs, e_normal, t):
-        """Kinetic + drive spring + tangential spring + normal spring energy (in the tangent
-        frame the kinetic energy is m (u^2 + w^2) / 2, from the state's own slots)."""
+    def _contact_energy(self, penetration: float) -> float:
+        """The contact law's potential U(delta), 0 out of contact (the law's Python function:
+        an output read compiles nothing)."""
+        potential = law("contact", self.settings.readings.get("contact", 0)).module.potential.py_func
+        return float(potential(penetration, self.prm)) if penetration > 0.0 else 0.0
+
+    def _stored_energy(self, obs, t):
+        """Kinetic + drive spring + friction spring + contact energy, each booked as its
+        potential at the observed state (in the tangent frame the kinetic energy is
+        m (u^2 + w^2) / 2, from the state's own slots): so the energy residual measures
+        the truth, also where a contact law is not conservative."""
         p = self.parameters
         x, vx, vz, shear = obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F]
         stretch = x - p["V_d"] * t
+        friction = float(law("friction", self.settings.readings.get("friction", 0)).module.energy.py_func(shear, self.prm))
         return (0.5 * p["m"] * (vx * vx + vz * vz) + 0.5 * p["k_d"] * stretch * stretch
-                + 0.5 * p["k_t"] * shear * shear + e_normal)
+                + friction + self._contact_energy(obs[L.O_PENETRATION]))
 
     def _observables(self) -> dict:
         # A native front end advances the time without dropping the cache: the cache is the
@@ -336,11 +344,11 @@ class Block:
             obs = self._observe()
             residual = 0.0
             if self.energy_balance:
-                stored = self._stored_energy(obs, obs[L.O_E_NORMAL], obs[L.O_T])
+                stored = self._stored_energy(obs, obs[L.O_T])
                 residual = stored - self.y[L.Y_E_START] - obs[L.O_WORK] + obs[L.O_DISSIPATED]
             pen, x, z, vx, vz = obs[L.O_PENETRATION], obs[L.O_X], obs[L.O_Z], obs[L.O_VX], obs[L.O_VZ]
             surface_z = z + pen / obs[L.O_COS]
-            if self.settings.kind != self.settings.variant.kind:  # a reading other than the default
+            if self._maps_to_point():
                 surface_z, z, vx, vz = self._as_point(x, z, vx, vz, pen)
             self._observed = {
                 "x": float(x), "z": float(z), "vx": float(vx), "vz": float(vz),
@@ -360,6 +368,12 @@ class Block:
                                    for name, key in interface.COST_OUTPUTS.items()})
             self._observed_time = self.time
         return self._observed
+
+    def _maps_to_point(self) -> bool:
+        """Whether outputs go through ``_as_point``: any reading other than the default
+        (the laws do not change what the state slots mean)."""
+        r = self.settings.readings
+        return bool(r["formulation"] or r["coulomb_normal"] or r["flight"])
 
     def _as_point(self, x, z, vx, vz, pen):
         """Surface height under the block and the block as a point (z, vx, vz).  In the

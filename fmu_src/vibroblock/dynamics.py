@@ -38,15 +38,20 @@ import math
 from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from .layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_MUS, P_VD
-from .models import load, profile
-from .readings import applied_load, free_flight, tangent_frame
+from .laws import bound_normal, contact_dissipation, contact_elastic, contact_force, friction_spring_force
+from .laws import friction_rule as law_friction_rule
+from .laws.plate_vertical import motion as plate_motion  # noqa: F401  (the one plate law, for the integrators)
+from .layout import P_GT, P_KD, P_VD
+from .laws import contact_conservative
+from .models import curvature, load, profile
+from .readings import free_flight, tangent_frame
 
 
 @njit(inline="always")
-def normal_force(penetration, u_n, prm):
+def normal_force(kind, penetration, u_n, prm):
+    """The contact law's normal force N, 0 out of contact (``laws``: contact)."""
     if penetration > 0.0:
-        return prm[P_KN] * penetration - prm[P_GN] * u_n
+        return contact_force(kind, penetration, u_n, prm)
     return 0.0
 
 
@@ -74,12 +79,12 @@ def surface_contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     if tangent_frame(kind):  # state (x, zeta, u, w): the plate moves along the local normal
         penetration = plate_z - z
         u_n = vz - plate_v
-        return penetration, u_n, vx, cos_a, sin_a, normal_force(penetration, u_n, prm)
+        return penetration, u_n, vx, cos_a, sin_a, normal_force(kind, penetration, u_n, prm)
     penetration = (plate_z + height - z) * cos_a
     rel_vz = vz - plate_v
     u_n = rel_vz * cos_a - vx * sin_a
     u_t = vx * cos_a + rel_vz * sin_a
-    return penetration, u_n, u_t, cos_a, sin_a, normal_force(penetration, u_n, prm)
+    return penetration, u_n, u_t, cos_a, sin_a, normal_force(kind, penetration, u_n, prm)
 
 
 @njit(inline="always")
@@ -99,17 +104,33 @@ def frame_load(kind, cos_a, sin_a, prm):
 
 
 @njit(inline="always")
-def force(kind, x, t, penetration, normal, u_t, cos_a, sin_a, shear, prm):
-    """Total force on the block (callers divide by m once per step, not per call)."""
+def curvature_force(kind, x, penetration, cos_a, sin_a, prm):
+    """The x-component the gradient of a conservative contact's potential U(delta) adds to
+    its normal force N n on a curved plate in fixed axes: U'(delta) delta tan(a) da/dx
+    = U'(delta) delta sin(a) cos(a) h''(x), since delta = (Z_p - z) cos(a) varies with x
+    through cos(a) too (docs/physics.md, Sec. 9).  Zero on a flat plate, in the tangent
+    frame (whose equations have no curvature terms), and for a law that is not conservative."""
+    if sin_a == 0.0 or tangent_frame(kind) or not contact_conservative(kind):
+        return 0.0
+    return contact_elastic(kind, penetration, prm) * penetration * sin_a * cos_a * curvature(kind, x, prm)
+
+
+@njit(inline="always")
+def force(kind, x, t, engaged, penetration, normal, u_t, cos_a, sin_a, shear, prm):
+    """Total force on the block (callers divide by m once per step, not per call).
+    ``engaged`` gates the contact's tangential spring and curvature term (a scheme that
+    continues a contact phase across delta = 0 keeps it open); ``penetration`` is delta."""
     tangential = -prm[P_GT] * u_t
-    if penetration > 0.0:
-        tangential -= prm[P_KT] * shear
+    if engaged:
+        tangential -= friction_spring_force(kind, shear, prm)
     if tangent_frame(kind):  # along the local tangent and normal (Eqs. 3-6)
         stretch = prm[P_KD] * (x - prm[P_VD] * t)
         load_t, load_n = frame_load(kind, cos_a, sin_a, prm)
         return -stretch * cos_a + tangential + load_t, normal + stretch * sin_a + load_n
     load_x, load_z = load(kind, cos_a, sin_a, prm)
     fx = -prm[P_KD] * (x - prm[P_VD] * t) - normal * sin_a + tangential * cos_a + load_x
+    if engaged:
+        fx += curvature_force(kind, x, penetration, cos_a, sin_a, prm)
     fz = normal * cos_a + tangential * sin_a + load_z
     return fx, fz
 
@@ -131,9 +152,9 @@ def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal
     dissipation = prm[P_GT] * u_t * u_t
     storage = 0.0
     if penetration > 0.0:
-        tangential -= prm[P_KT] * shear
-        dissipation += prm[P_GN] * u_n * u_n
-        storage = -prm[P_KN] * penetration * u_n
+        tangential -= friction_spring_force(kind, shear, prm)
+        dissipation += contact_dissipation(kind, penetration, u_n, prm)
+        storage = -contact_elastic(kind, penetration, prm) * u_n
     if tangent_frame(kind):  # the normal components of load and drive work on zeta (docs/physics.md, Sec. 7)
         load_t, load_n = frame_load(kind, cos_a, sin_a, prm)
         work = (prm[P_KD] * (prm[P_VD] * t - x) * prm[P_VD] + normal * plate_v + load_t * vx
@@ -147,46 +168,16 @@ def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal
 
 
 @njit(inline="always")
-def applied_normal(kind, x, t, prm):
-    """N_a = -(load + drive spring) . n at abscissa x and time t: m g (A),
-    m g cos a - k_d (x - V_d t) sin a (B), P_l - k_d (x - V_d t) sin a (C)."""
-    slope = profile(kind, x, prm)[1]
-    if slope == 0.0:
-        cos_a, sin_a = 1.0, 0.0
-    else:
-        cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
-        sin_a = slope * cos_a
-    load_x, load_z = load(kind, cos_a, sin_a, prm)
-    return load_x * sin_a - load_z * cos_a - prm[P_KD] * (x - prm[P_VD] * t) * sin_a
-
-
-@njit(inline="always")
 def coulomb_bound(kind, normal, x, t, prm):
-    """The N of the Coulomb bound mu_s N at the block's abscissa x and time t: the contact
-    force ``normal`` (coulomb_normal = 0), or the applied load N_a (coulomb_normal = 1)."""
-    if applied_load(kind):
-        return applied_normal(kind, x, t, prm)
-    return normal
+    """The N of the Coulomb bound mu_s N at the block's abscissa x and time t (``laws``:
+    bound): the contact force ``normal`` (coulomb_normal = 0), or the applied load N_a
+    (coulomb_normal = 1)."""
+    return bound_normal(kind, normal, x, t, prm)
 
 
 @njit(inline="always")
-def friction_rule(shear, penetration, normal, prm):
-    """The paper's reset rule: F = 0 once detached, or when |k_t F| >= mu_s N.
-
-    Returns the new shear displacement and whether a Coulomb reset of a loaded
-    spring happened (resets of an already relaxed spring are not counted).
-    """
-    if penetration <= 0.0:
-        return 0.0, False
-    if abs(prm[P_KT] * shear) >= prm[P_MUS] * normal:
-        return 0.0, shear != 0.0
-    return shear, False
-
-
-@njit(inline="always")
-def plate_motion(amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau):
-    """Plate height and velocity: harmonic drive plus the external input, which is held
-    at constant acceleration over a communication step (tau = time since it was set)."""
-    z = amp * sin_phase + ext_z + tau * (ext_v + 0.5 * ext_a * tau)
-    v = amp * omega * cos_phase + ext_v + ext_a * tau
-    return z, v
+def friction_rule(kind, shear, penetration, normal, prm):
+    """The friction law's rule at a new state (``laws``: friction; the paper's: F = 0 once
+    detached, or when |k_t F| >= mu_s N).  Returns the new shear displacement and whether
+    a reset of a loaded spring happened."""
+    return law_friction_rule(kind, shear, penetration, normal, prm)

@@ -4,7 +4,10 @@ The README's interface table is this module's output; a test keeps the two equal
 """
 from .integrators import INTEGRATOR_RECORDS, INTEGRATORS
 from .models import VARIANTS, offered_by
-from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS
+from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS
+from .readings import choices
+
+CHOICES = choices()  # the readings and the laws
 
 INPUTS = {
     "plate_z": ("delta_0", "external plate height, added to the internal drive"),
@@ -58,8 +61,8 @@ INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items(
 
 
 def reading_choices(name: str) -> str:
-    """The FMU description of a reading: its values and what each means."""
-    return "; ".join(f"{value} = {text}" for value, text in READINGS[name][1].items()) + \
+    """The FMU description of a reading or a law: its values and what each means."""
+    return "; ".join(f"{value} = {text}" for value, text in CHOICES[name][1].items()) + \
         " (docs/physics.md; fixed before initialization)"
 
 
@@ -98,7 +101,7 @@ def markdown_table() -> str:
         rows.append(f"| `{name}` | parameter (Boolean) | {_models_column(offered_by(models))} | | "
                     f"{str(default).lower()} | {text} |")
     rows.append(f"| `initial_state` | parameter (Integer) | {every} | | 0 | {INITIAL_CHOICES} |")
-    for name, (models, _) in READINGS.items():
+    for name, (models, _) in CHOICES.items():
         rows.append(f"| `{name}` | parameter (Integer) | {_models_column(offered_by(models))} | | 0 | "
                     f"{reading_choices(name)} |")
     rows.append(f"| `energy_balance` | parameter (Boolean) | {every} | | false | {ENERGY_BALANCE} |")

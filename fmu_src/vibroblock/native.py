@@ -41,7 +41,7 @@ from . import layout as L  # noqa: E402
 from .integrators import adaptive, event_driven, fixed_step  # noqa: E402
 from . import scenes  # noqa: E402  (after the integrators, which register its scheme)
 
-LAYOUT = 2  # bump with any change of NativeStep's fields
+LAYOUT = 3  # bump with any change of NativeStep's fields
 
 # Sources of a native output other than an observation slot (``layout.O_*``): the plate
 # surface under the block, z + penetration / cos(alpha); and an output that is 0 in this
@@ -56,10 +56,10 @@ RETURNED_OK = STATUS_SHIFT + fixed_step.OK
 OBSERVED_OK = STATUS_SHIFT  # what an observe entry returns (a kernel that raised: 0)
 
 _F64, _I64 = types.CPointer(types.float64), types.CPointer(types.int64)
-# (flags, y, cnt, drv, prm, n_steps, track_energy) -> status + STATUS_SHIFT
-SIGNATURE = types.int64(types.int64, _F64, _I64, _F64, _F64, types.int64, types.int64)
-# (flags, y, cnt, drv, prm, h, track_energy, obs) -> STATUS_SHIFT when obs is filled
-OBSERVE_SIGNATURE = types.int64(types.int64, _F64, _I64, _F64, _F64, types.float64, types.int64, _F64)
+# (kind, flags, y, cnt, drv, prm, n_steps, track_energy) -> status + STATUS_SHIFT
+SIGNATURE = types.int64(types.int64, types.int64, _F64, _I64, _F64, _F64, types.int64, types.int64)
+# (kind, flags, y, cnt, drv, prm, h, track_energy, obs) -> STATUS_SHIFT when obs is filled
+OBSERVE_SIGNATURE = types.int64(types.int64, types.int64, _F64, _I64, _F64, _F64, types.float64, types.int64, _F64)
 
 
 class NativeStep(ctypes.Structure):
@@ -72,6 +72,7 @@ class NativeStep(ctypes.Structure):
         ("held", ctypes.c_int64),
         ("advance", ctypes.c_void_p),  # SIGNATURE
         ("returned_ok", ctypes.c_int64),  # what advance returns when the kernel finished
+        ("kind", ctypes.c_int64),  # the run's variant, readings and laws (vibroblock.readings)
         ("flags", ctypes.c_int64),
         ("y", ctypes.c_void_p),
         ("cnt", ctypes.c_void_p),
@@ -93,67 +94,67 @@ class NativeStep(ctypes.Structure):
     ]
 
 
-# One factory per advance kernel, each compiling a cfunc for one (kind, method): the
-# kernels take both as literals.  The kernel is named in the body, not captured: numba
+# One factory per advance kernel, each compiling a cfunc for one method (the kernels take
+# it as a literal; kind is an argument, so one cfunc serves every variant and reading).  The kernel is named in the body, not captured: numba
 # keys a cached cfunc by its closure's values, which must be plain numbers to be found
 # again by the next process.
-def _fixed_step_entry(kind: int, method: int):
+def _fixed_step_entry(method: int):
     @cfunc(SIGNATURE, cache=True)
-    def advance(flags, y, cnt, drv, prm, n_steps, track_energy):
+    def advance(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
         return STATUS_SHIFT + fixed_step.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
                                                  carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
                                                  track_energy != 0)
     return advance
 
 
-def _event_driven_entry(kind: int, method: int):
+def _event_driven_entry(method: int):
     @cfunc(SIGNATURE, cache=True)
-    def advance(flags, y, cnt, drv, prm, n_steps, track_energy):
+    def advance(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
         return STATUS_SHIFT + event_driven.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
                                                    carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
                                                    track_energy != 0)
     return advance
 
 
-def _adaptive_entry(kind: int, method: int):
+def _adaptive_entry(method: int):
     @cfunc(SIGNATURE, cache=True)
-    def advance(flags, y, cnt, drv, prm, n_steps, track_energy):
+    def advance(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
         return STATUS_SHIFT + adaptive.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
                                                carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
                                                track_energy != 0)
     return advance
 
 
-def _fixed_step_observe(kind: int, method: int):
+def _fixed_step_observe(method: int):
     @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
         fixed_step.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
                            carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
         return OBSERVED_OK
     return observe
 
 
-def _event_driven_observe(kind: int, method: int):
+def _event_driven_observe(method: int):
     @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
         event_driven.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
                              carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
         return OBSERVED_OK
     return observe
 
 
-def _adaptive_observe(kind: int, method: int):
+def _adaptive_observe(method: int):
     @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
         adaptive.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
                          carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
         return OBSERVED_OK
     return observe
 
 
-def _scene_observe(kind: int, method: int):
+def _scene_observe(method: int):
     @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(flags, y, cnt, drv, prm, h, track_energy, obs):
+    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
         scenes.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
                        carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
         return OBSERVED_OK
@@ -164,17 +165,17 @@ _FACTORIES = {fixed_step.advance: _fixed_step_entry, event_driven.advance: _even
               adaptive.advance: _adaptive_entry, fixed_step.observe: _fixed_step_observe,
               event_driven.observe: _event_driven_observe, adaptive.observe: _adaptive_observe,
               scenes.observe: _scene_observe}
-_ENTRIES: dict = {}  # (kernel, kind, method) -> cfunc, kept alive with its code
+_ENTRIES: dict = {}  # (kernel, method) -> cfunc, kept alive with its code
 
 
-def entry_address(kernel, kind: int, method: int) -> int | None:
-    """The C address of ``kernel`` (an advance or observe kernel) for (kind, method),
-    compiled or loaded from the cache once per process; None for a kernel without a C entry."""
-    key = (kernel, kind, method)
+def entry_address(kernel, method: int) -> int | None:
+    """The C address of ``kernel`` (an advance or observe kernel) for ``method``, compiled
+    or loaded from the cache once per process; None for a kernel without a C entry."""
+    key = (kernel, method)
     if key not in _ENTRIES:
         factory = _FACTORIES.get(kernel)
         try:
-            _ENTRIES[key] = factory(kind, method) if factory is not None else None
+            _ENTRIES[key] = factory(method) if factory is not None else None
         except Exception:  # noqa: BLE001 - no C entry is no error: every doStep goes through Python
             _ENTRIES[key] = None
     entry = _ENTRIES[key]

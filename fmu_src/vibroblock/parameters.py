@@ -120,17 +120,15 @@ READINGS = {
         0: "fixed_axes: Newton's law for the block as a point in fixed axes, the plate moving vertically",
         1: "tangent_frame: the paper's Eqs. (3)-(6) as printed, in a frame tangent to the plate at the block",
     }),
-    "coulomb_normal": (ALL_VARIANTS, {
-        0: "contact_force: Coulomb bound mu_s N with N = k_n delta - gamma_n u_n",
-        1: "applied_load: N = the load's and the drive spring's normal components, -(load + drive) . n",
-    }),
     "flight": (ALL_VARIANTS, {
         0: "surface: off contact the load and tangential dashpot act as on the surface under the block",
         1: "free: off contact a free particle (vertical load, dashpot on dx/dt); fixed_axes only",
     }),
 }
+# The laws (contact, Coulomb bound, ...) are Integer choices of the same kind, registered
+# in ``vibroblock.laws``; ``vibroblock.readings.CHOICES`` holds both tables.
 
 
-def reading_names(name: str) -> dict[int, str]:
-    """value -> short name of one reading (e.g. 0 -> "fixed_axes")."""
-    return {value: text.split(":", 1)[0] for value, text in READINGS[name][1].items()}
+def reading_names(name: str, table: dict | None = None) -> dict[int, str]:
+    """value -> short name of one reading (e.g. 0 -> "fixed_axes"), or of one choice of ``table``."""
+    return {value: text.split(":", 1)[0] for value, text in (table or READINGS)[name][1].items()}

@@ -1,14 +1,15 @@
-"""The readings of the paper a run chooses (docs/physics.md): ``formulation``,
-``coulomb_normal`` and ``flight``, encoded in the kernels' literal ``kind``.
+"""The physics a run chooses, as the kernels' ``kind``: the variant, the readings of the
+paper (docs/physics.md: ``formulation``, ``flight``) and the laws (``vibroblock.laws``:
+``contact``, ``coulomb_normal``, ...).
 
-They are constants of a run, so they are compile-time constants of the kernels: ``kind``
-is the variant's index plus one bit per non-default reading, and the compiled helpers
-below (``tangent_frame(kind)``, ``applied_load(kind)``, ``free_flight(kind)``) return
-constants resolved when a kernel is specialised, so every branch on them folds away.
-The default reading (all three 0) is the variant's index alone: its kernels are the
-ones compiled before these options existed.
+They are constants of a run.  ``kind`` is a plain integer the kernels branch on (a
+perfectly predicted branch), so one compiled kernel serves every combination: the
+compiled helpers below (``tangent_frame(kind)``, ``free_flight(kind)``) and the laws'
+dispatch read their bits at run time.  (Given a numba literal instead, they fold to
+constants.)  The defaults (every choice 0) are the variant's index alone.
 
-``kind`` = variant index (bits 0-2) | TANGENT_FRAME | APPLIED_LOAD | FREE_FLIGHT.
+``kind`` = variant index (bits 0-2) | TANGENT_FRAME | FREE_FLIGHT | the laws' bits
+(``laws.AXES``: the Coulomb bound bit 4, the contact law bits 6-7, ...).
 """
 from __future__ import annotations
 
@@ -18,14 +19,27 @@ from numba.extending import overload  # noqa: E402
 
 VARIANT_MASK = 0b111
 TANGENT_FRAME = 1 << 3  # formulation = 1
-APPLIED_LOAD = 1 << 4  # coulomb_normal = 1
 FREE_FLIGHT = 1 << 5  # flight = 1
 
 
-def encode(variant_kind: int, formulation: int = 0, coulomb_normal: int = 0, flight: int = 0) -> int:
-    """The kernels' ``kind`` for a variant and its readings."""
-    return (variant_kind | (TANGENT_FRAME if formulation else 0) | (APPLIED_LOAD if coulomb_normal else 0)
-            | (FREE_FLIGHT if flight else 0))
+def encode(variant_kind: int, choices: dict | None = None) -> int:
+    """The kernels' ``kind`` for a variant and its readings and laws ({name: value},
+    absent: 0)."""
+    from .laws import encode as law_bits  # (the laws import the variants, which import this module)
+    choices = choices or {}
+    return (variant_kind | (TANGENT_FRAME if choices.get("formulation") else 0)
+            | (FREE_FLIGHT if choices.get("flight") else 0) | law_bits(choices))
+
+
+def choices() -> dict[str, tuple[str, dict[int, str]]]:
+    """Every Integer choice of the physics, in the FMU's order: the readings
+    (``parameters.READINGS``) and the laws (``laws.choices``), name -> (variants,
+    {value: "name: meaning"})."""
+    from .laws import choices as law_choices
+    from .parameters import READINGS
+    laws = law_choices()
+    return {"formulation": READINGS["formulation"], "coulomb_normal": laws.pop("coulomb_normal"),
+            "flight": READINGS["flight"], **laws}
 
 
 def variant_kind(kind: int) -> int:
@@ -37,23 +51,20 @@ def tangent_frame(kind):
     """True if ``kind`` integrates the paper's Eqs. (3)-(6) as printed (compiled code only)."""
 
 
-def applied_load(kind):
-    """True if the Coulomb bound's N is the applied load (compiled code only)."""
-
-
 def free_flight(kind):
     """True if a block off contact is a free particle (compiled code only)."""
 
 
 def _constant(bit):
     def typer(kind):
-        if isinstance(kind, types.IntegerLiteral):
+        if isinstance(kind, types.IntegerLiteral):  # folded away where a kernel is specialised on kind
             value = bool(kind.literal_value & bit)
             return lambda kind: value
-        return None  # the kernel must pass kind as a literal (numba.literally)
+        if isinstance(kind, types.Integer):  # a run constant: a perfectly predicted branch
+            return lambda kind: (kind & bit) != 0
+        return None
     return typer
 
 
 overload(tangent_frame, inline="always")(_constant(TANGENT_FRAME))
-overload(applied_load, inline="always")(_constant(APPLIED_LOAD))
 overload(free_flight, inline="always")(_constant(FREE_FLIGHT))

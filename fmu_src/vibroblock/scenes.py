@@ -36,12 +36,13 @@ tangential relative motion, clipped to +- mu_s N.  First order.
 import math
 
 from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
-from numba import literally, njit
+from numba import njit
 
 from .dynamics import contact, friction_rule
+from .laws import contact_dissipation, contact_elastic, friction_released, friction_spring_force
 from .integrators.fixed_step import OK, STOP, record_observation
 from .integrators.plate import drive_sin_cos, phase_after, plate_after, plate_at
-from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_KT, P_M,
+from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_M,
                      P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .models import load, profile
 
@@ -90,7 +91,7 @@ def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, 
     load_x, load_z = load(kind, c, s, prm)
     tangential = -prm[P_GT] * u_t
     if engaged and not coulomb:
-        tangential -= prm[P_KT] * shear
+        tangential -= friction_spring_force(kind, shear, prm)
     fx = drive + load_x + tangential * c
     fz = load_z + tangential * s
     if rigid:
@@ -155,8 +156,8 @@ def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, 
         if coulomb:
             d_dissipated -= friction * (vx1 * c1 + (vz1 - pv1) * s1) * h
         if not rigid and pen > 0.0:
-            d_dissipated += prm[P_GN] * u_n * u_n * h
-            d_normal = -prm[P_KN] * pen * u_n * h
+            d_dissipated += contact_dissipation(kind, pen, u_n, prm) * h
+            d_normal = -contact_elastic(kind, pen, prm) * u_n * h
     dv = vx1 - prm[P_VD]
     return x1, z1, vx1, vz1, shear, engaged_end, normal, friction, h * dv * dv, d_work, d_dissipated, d_normal
 
@@ -203,7 +204,6 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     """``fixed_step.observe`` for a reduced block: the state at t_n + h (one scratch step
     from the grid state), and the contact state, normal and friction forces acting there
     (those of a step of dt starting at that state)."""
-    kind = literally(kind)
     dt = drv[D_DT]
     rigid, coulomb = (flags & RIGID) != 0, (flags & COULOMB) != 0
     r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])
@@ -227,12 +227,12 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             shear = 0.0
         else:
             end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
-            shear, reset = friction_rule(shear, 1.0 if engaged else 0.0, end_normal, prm)
+            shear, reset = friction_rule(kind, shear, 1.0 if engaged else 0.0, end_normal, prm)
             slips += reset
         phi += d_phi
         if track_energy:
             work += d_work
-            dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+            dissipated += d_dissipated + friction_released(kind, loaded, shear, prm)
             e_normal += d_normal
         t += h
         pz0, pv0 = pz1, pv1
@@ -246,6 +246,6 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     if rigid:
         normal = probe[6]
         in_contact = pen >= -ATTACHED_TOLERANCE * (1.0 + abs(z)) and normal > 0.0
-    friction = probe[7] if coulomb else (-prm[P_KT] * shear if in_contact else 0.0)
+    friction = probe[7] if coulomb else (-friction_spring_force(kind, shear, prm) if in_contact else 0.0)
     return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,
                               e_normal, in_contact, friction)

@@ -14,9 +14,11 @@ import numpy as np
 
 from .integrators import INTEGRATORS, REDUCED_SCENE, Integrator, integrator as integrator_record
 from .models import offered_by, variant
-from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS, reading_names
-from .readings import encode
+from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS, reading_names
+from .readings import choices, encode
 from .scenes import COULOMB, FROZEN, RIGID
+
+CHOICES = choices()  # the readings of the paper and the laws: Integer choices fixed before a run
 
 
 class ModelError(ValueError):
@@ -46,7 +48,7 @@ class Settings:
         self.initial_state = 0
         self.energy_balance = False
         self.scene = {name: False for name in SCENE_OPTIONS}
-        self.readings = {name: 0 for name in READINGS}
+        self.readings = {name: 0 for name in CHOICES}  # the readings and the laws
         self.options = {name: default for name, (_, default, _) in INTEGRATOR_OPTIONS.items()}
         self.set_integrator(integrator)
         self.set_initial_state(initial_state)
@@ -56,7 +58,7 @@ class Settings:
                 self.set_scene_option(name, value)
             elif name in INTEGRATOR_OPTIONS:
                 self.set_integrator_option(name, value)
-            elif name in READINGS:
+            elif name in CHOICES:
                 self.set_reading(name, value)
             else:
                 self.set_parameter(name, value)
@@ -122,12 +124,12 @@ class Settings:
         self.options[name] = bool(enabled)
 
     def set_reading(self, name: str, value: int | str) -> None:
-        """Choose a reading of the paper (``parameters.READINGS``: formulation,
-        coulomb_normal, flight), by its Integer value or its name."""
-        if name not in READINGS:
-            raise ModelError(f"unknown reading {name!r}; choose one of {sorted(READINGS)}")
-        models, _ = READINGS[name]
-        names = reading_names(name)
+        """Choose a reading of the paper or a law (``readings.CHOICES``: formulation,
+        coulomb_normal, flight, contact, ...), by its Integer value or its name."""
+        if name not in CHOICES:
+            raise ModelError(f"unknown reading or law {name!r}; choose one of {sorted(CHOICES)}")
+        models, _ = CHOICES[name]
+        names = reading_names(name, CHOICES)
         if isinstance(value, str) and value in names.values():
             value = {text: code for code, text in names.items()}[value]
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or int(value) not in names:
@@ -142,9 +144,8 @@ class Settings:
 
     @property
     def kind(self) -> int:
-        """The kernels' compile-time ``kind``: the variant and its readings (``vibroblock.readings``)."""
-        r = self.readings
-        return encode(self.variant.kind, r["formulation"], r["coulomb_normal"], r["flight"])
+        """The kernels' ``kind``: the variant, its readings and its laws (``vibroblock.readings``)."""
+        return encode(self.variant.kind, self.readings)
 
     @property
     def tangent_frame(self) -> bool:

@@ -18,12 +18,12 @@ from pythonfmu.variables import Boolean, Integer, Real
 
 from .block import Block
 from .fmi import TIME_TOLERANCE, FmuFacade, fmu_class
-from .interface import ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS, reading_choices
+from .interface import CHOICES, ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS, reading_choices
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .integrators import INTEGRATORS
 from .models import offered_by, variant
 from .native import NativeStep
-from .parameters import INTEGRATOR_OPTIONS, READINGS, SCENE_OPTIONS
+from .parameters import INTEGRATOR_OPTIONS, SCENE_OPTIONS
 from .settings import ModelError
 
 
@@ -79,7 +79,7 @@ class BlockFacade(FmuFacade):
             "energy_balance", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=ENERGY_BALANCE, getter=lambda: self.block.energy_balance,
             setter=lambda value: self._guard(self.block.set_energy_balance, bool(value))))
-        for name, (models, _) in READINGS.items():  # only the readings this model offers
+        for name, (models, _) in CHOICES.items():  # only the readings and laws this model offers
             if self.model in offered_by(models):
                 self.register_variable(Integer(
                     name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,

@@ -183,19 +183,22 @@ class Integrator:
         return text.format(integrator=self.name, **where)
 
 
-# (kernel, kind, method) -> compiled entry point.  The kernels take kind and method as
-# literals (compile-time constants); calling the dispatcher with plain ints would make
-# numba retry the non-literal typing on every call (~0.1 s), so the specialization is
-# compiled (or loaded from the cache) once and its entry point called directly.
+# (kernel, method) -> compiled entry point.  The kernels take ``method`` as a literal (a
+# fixed-step scheme is inlined into its driver's loop) and ``kind`` -- the variant, the
+# readings and the laws of the run -- as a plain integer: a run constant the kernels
+# branch on, so one compilation serves every variant and reading.  Calling the
+# dispatcher with a plain int for ``method`` would make numba retry the non-literal
+# typing on every call (~0.1 s), so the specialization is compiled (or loaded from the
+# cache) once and its entry point called directly.
 _ENTRY_POINTS: dict = {}
 
 
 def _entry_point(kernel, kind: int, method: int, args: tuple):
-    """The compiled entry point of ``kernel`` for (kind, method) and arguments typed like ``args``."""
-    key = (kernel, kind, method)
+    """The compiled entry point of ``kernel`` for ``method`` and arguments typed like ``args``."""
+    key = (kernel, method)
     entry = _ENTRY_POINTS.get(key)
     if entry is None:
-        signature = (types.literal(kind), types.literal(method), *(typeof(a) for a in args))
+        signature = (types.int64, types.literal(method), *(typeof(a) for a in args))
         kernel.compile(signature)
         entry = _ENTRY_POINTS[key] = kernel.overloads[signature].entry_point
     return entry

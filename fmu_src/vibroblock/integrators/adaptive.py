@@ -109,9 +109,10 @@ import math
 
 import numpy as np
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
-from numba import literally, njit
+from numba import njit
 
 from ..dynamics import contact, coulomb_bound, energy_rates, force, plate_motion, position_rates, surface_contact
+from ..laws import contact_force
 from .fixed_step import kahan_add, record_observation
 from .plate import TWO_PI, drive_phase
 from ..layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_REJECTED, C_SLIPS, C_STEP,
@@ -276,9 +277,9 @@ def _rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
         if free_flight(kind):  # a free particle: the fixed axes are its frame (dynamics.contact)
             u_t, cos_a, sin_a = vx, 1.0, 0.0
     else:
-        normal = prm[P_KN] * pen - prm[P_GN] * u_n
+        normal = contact_force(kind, pen, u_n, prm)  # continued across delta = 0
         gate = 1.0
-    fx, fz = force(kind, x, t, gate, normal, u_t, cos_a, sin_a, shear, prm)
+    fx, fz = force(kind, x, t, gate > 0.0, pen, normal, u_t, cos_a, sin_a, shear, prm)
     inv_m = 1.0 / prm[P_M]
     rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz); (u cos a, w) in the tangent frame
     out[0], out[1], out[2], out[3] = rate_x, rate_z, fx * inv_m, fz * inv_m
@@ -301,7 +302,7 @@ def _bound(kind, v, t, pz, pv, prm):
     """Penetration and the Coulomb bound mu_s N at time t: N the contact force continued
     across delta = 0, or the applied load at the block's x and t (``coulomb_bound``)."""
     pen, u_n, u_t, cos_a, sin_a, normal = surface_contact(kind, v[0], v[1], v[2], v[3], pz, pv, prm)
-    return pen, prm[P_MUS] * coulomb_bound(kind, prm[P_KN] * pen - prm[P_GN] * u_n, v[0], t, prm)
+    return pen, prm[P_MUS] * coulomb_bound(kind, contact_force(kind, pen, u_n, prm), v[0], t, prm)
 
 
 @njit(inline="always")
@@ -1450,7 +1451,6 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by n_steps grid steps (see the module doc): the end time
     t0 + (n + n_steps) dt is reached by error-controlled steps whatever n_steps is.
     Returns 0, or a negative status with the arrays untouched."""
-    kind = literally(kind)
     out = y.copy()
     costs = np.zeros(6, dtype=np.int64)
     n = cnt[C_STEP]
@@ -1472,7 +1472,6 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
 def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     """Fill ``obs`` with the state at t_n + h (0 <= h < dt) by a short integration from
     the grid state, without touching the stored state (layout of ``fixed_step.observe``)."""
-    kind = literally(kind)
     n = cnt[C_STEP]
     out = y.copy()
     costs = np.zeros(6, dtype=np.int64)

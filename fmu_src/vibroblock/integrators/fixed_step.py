@@ -32,9 +32,10 @@ from numba import literally, njit, types
 from numba.extending import overload
 
 from ..dynamics import contact, coulomb_bound, friction_rule
+from ..laws import friction_released, friction_spring_force
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
-                      P_KT, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+                      Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .plate import drive_sin_cos, next_sin_cos, phase_after, plate_after, plate_at, plate_moves
 
 OK, STOP = 0, 1
@@ -97,16 +98,16 @@ def is_finite_state(x, z, vx, vz, shear):
 
 
 @njit(inline="always")
-def settle(prm, shear, rule_penetration, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
+def settle(kind, prm, shear, rule_penetration, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
            d_phi, d_work, d_dissipated, d_normal, track_energy):
     """End of every step of every scheme: the friction rule at the new state (a reset
     releases k_t F^2/2, counted as dissipated), then the step's quadratures."""
     loaded = shear
-    shear, reset = friction_rule(shear, rule_penetration, rule_normal, prm)
+    shear, reset = friction_rule(kind, shear, rule_penetration, rule_normal, prm)
     phi, phi_c = kahan_add(phi, phi_c, d_phi)
     if track_energy:
         work += d_work
-        dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+        dissipated += d_dissipated + friction_released(kind, loaded, shear, prm)
         e_normal += d_normal
     return shear, slips + reset, phi, phi_c, work, dissipated, e_normal
 
@@ -116,7 +117,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     """Advance by up to n_steps grid steps with scheme ``method``.  Returns OK, STOP (a
     scene's guard stopped before a step; the steps taken so far are stored) or a
     negative failure code (the arrays are left as they were on entry)."""
-    kind, method = literally(kind), literally(method)
+    method = literally(method)
     prepare, step = scheme_prepare(method), scheme_step(method)
     t0, dt = drv[D_T0], drv[D_DT]
     ctx = prepare(kind, flags, drv, prm, dt)
@@ -152,7 +153,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
         x, z, vx, vz, contact0 = x1, z1, vx1, vz1, contact1
         rule_normal = coulomb_bound(kind, rule_normal, x, t1, prm)  # the contact force, or the applied load
         shear, slips, phi, phi_c, work, dissipated, e_normal = settle(
-            prm, shear1, rule_pen, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
+            kind, prm, shear1, rule_pen, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
             d_phi, d_work, d_dissipated, d_normal, track_energy)
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         done += 1
@@ -177,7 +178,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     recurrence) at t_n, t_n + h/2 and t_n + h: outputs are at the requested time while
     the stored trajectory stays on the grid, independent of the communication steps.
     A scratch step that fails leaves the grid state (with the plate at t_n + h)."""
-    kind, method = literally(kind), literally(method)
+    method = literally(method)
     prepare, step = scheme_prepare(method), scheme_step(method)
     t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
@@ -204,14 +205,14 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             rule_pen, rule_normal = state_contact[0], state_contact[5]
         rule_normal = coulomb_bound(kind, rule_normal, x, t + h, prm)
         loaded = shear
-        shear, reset = friction_rule(shear, rule_pen, rule_normal, prm)
+        shear, reset = friction_rule(kind, shear, rule_pen, rule_normal, prm)
         slips += reset
         phi += d_phi
         if track_energy:
             work += d_work
-            dissipated += d_dissipated + 0.5 * prm[P_KT] * (loaded * loaded - shear * shear)
+            dissipated += d_dissipated + friction_released(kind, loaded, shear, prm)
             e_normal += d_normal
         t += h
     pen, u_n, u_t, cos_a, sin_a, normal = state_contact
     return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,
-                              e_normal, pen > 0.0, -prm[P_KT] * shear if pen > 0.0 else 0.0)
+                              e_normal, pen > 0.0, -friction_spring_force(kind, shear, prm) if pen > 0.0 else 0.0)

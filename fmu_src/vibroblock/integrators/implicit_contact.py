@@ -80,7 +80,7 @@ import numpy as np
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from ..dynamics import contact
+from ..dynamics import contact, curvature_force
 from ..layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_VD
 from ..models import load, profile
 
@@ -329,6 +329,10 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
     load_x, load_z = load(kind, cos_m, sin_m, prm)
     force_n = -(drive + load_x) * sin_m + load_z * cos_m - m * plate_accel * cos_m
     force_t = (drive + load_x) * cos_m + load_z * sin_m - m * plate_accel * sin_m
+    if pen0 > 0.0 and sin_m != 0.0:  # a conservative contact's curvature term, held over the step like the load
+        curving = curvature_force(kind, x_mid, pen0, cos_m, sin_m, prm)
+        force_n -= curving * sin_m
+        force_t += curving * cos_m
     # Rate at which delta changes as the tangent line under the block turns
     # (d delta/dt = -u_n - delta tan(alpha) Omega), taken at the predicted midpoint.
     delta_rate = 0.0

@@ -23,7 +23,7 @@ def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
     """Accelerations, dF/dt, and the rates of the quadratures (phi, work, dissipation,
     normal-spring energy) at one stage."""
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
-    fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
+    fx, fz = force(kind, x, t, pen > 0.0, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_shear = u_t if pen > 0.0 else 0.0
     rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz) for a point
     dv = rate_x - prm[P_VD]

@@ -25,7 +25,7 @@ def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plat
     ``contact_now`` are known; returns the new state, its contact quantities, and the
     increments of phi, work, dissipation and normal-spring energy."""
     pen, u_n, u_t, cos_a, sin_a, normal = contact_now
-    fx, fz = force(kind, x, t, pen, normal, u_t, cos_a, sin_a, shear, prm)
+    fx, fz = force(kind, x, t, pen > 0.0, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_work = d_dissipated = d_normal = 0.0
     if track_energy:
         work, dissipation, storage = energy_rates(kind, x, vx, vz, t, pen, u_n, u_t, cos_a, sin_a, normal,

@@ -134,12 +134,43 @@ def load(kind, cos_a, sin_a, prm):
     """Confining force of variant ``kind`` (compiled code only)."""
 
 
+def curvature(kind, x, prm):
+    """Second derivative h''(x) of variant ``kind``'s surface (compiled code only)."""
+
+
+def _by_variant(attribute: str, arguments: str):
+    """A compiled function ``(kind, arguments) -> variant(kind).attribute(arguments)`` that
+    branches on the variant's index at run time: kind is a run constant, so the branch is
+    perfectly predicted, and one kernel serves every variant (one compilation, not one
+    per variant)."""
+    namespace = {f"_{v.kind}": getattr(v, attribute) for v in _BY_KIND.values()}
+    kinds = sorted(_BY_KIND)
+    lines = [f"def dispatch(kind, {arguments}):", f"    variant = kind & {VARIANT_MASK}"]
+    for i, k in enumerate(kinds[:-1]):  # (one return: numba inlines it into its callers)
+        lines.append(f"    {'if' if i == 0 else 'elif'} variant == {k}:")
+        lines.append(f"        result = _{k}({arguments})")
+    lines.append("    else:")
+    lines.append(f"        result = _{kinds[-1]}({arguments})")
+    lines.append("    return result")
+    exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registry's indices only
+    # Compiled on its own, not inlined at numba's level (whose inliner trips on the
+    # branches' shared result), and small enough for LLVM to inline it where it is called.
+    return njit(namespace["dispatch"])
+
+
+_PROFILE_BY_VARIANT = _by_variant("profile", "x, prm")
+_LOAD_BY_VARIANT = _by_variant("load", "cos_a, sin_a, prm")
+_CURVATURE_BY_VARIANT = _by_variant("curvature", "x, prm")
+
+
 @overload(profile, inline="always")
 def _profile(kind, x, prm):
-    if isinstance(kind, types.IntegerLiteral):
+    if isinstance(kind, types.IntegerLiteral):  # specialised on one variant
         geometry = _BY_KIND[kind.literal_value & VARIANT_MASK].profile
         return lambda kind, x, prm: geometry(x, prm)
-    return None  # the kernel must pass kind as a literal (numba.literally)
+    if isinstance(kind, types.Integer):
+        return lambda kind, x, prm: _PROFILE_BY_VARIANT(kind, x, prm)
+    return None
 
 
 @overload(load, inline="always")
@@ -147,4 +178,16 @@ def _load(kind, cos_a, sin_a, prm):
     if isinstance(kind, types.IntegerLiteral):
         force = _BY_KIND[kind.literal_value & VARIANT_MASK].load
         return lambda kind, cos_a, sin_a, prm: force(cos_a, sin_a, prm)
+    if isinstance(kind, types.Integer):
+        return lambda kind, cos_a, sin_a, prm: _LOAD_BY_VARIANT(kind, cos_a, sin_a, prm)
+    return None
+
+
+@overload(curvature, inline="always")
+def _curvature(kind, x, prm):
+    if isinstance(kind, types.IntegerLiteral):
+        second = _BY_KIND[kind.literal_value & VARIANT_MASK].curvature
+        return lambda kind, x, prm: second(x, prm)
+    if isinstance(kind, types.Integer):
+        return lambda kind, x, prm: _CURVATURE_BY_VARIANT(kind, x, prm)
     return None

@@ -18,9 +18,9 @@ from vibroblock import layout as L
 from vibroblock.interface import OUTPUTS
 from vibroblock.native import RETURNED_OK, STATUS_SHIFT, SURFACE_Z, ZERO, NativeStep
 
-ADVANCE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+ADVANCE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
                            ctypes.c_void_p, ctypes.c_int64, ctypes.c_int64)
-OBSERVE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+OBSERVE = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
                            ctypes.c_void_p, ctypes.c_double, ctypes.c_int64, ctypes.c_void_p)
 # Value references as an FMU would give them (any distinct numbers).
 REFS = {name: 100 + i for i, name in enumerate(OUTPUTS)}
@@ -55,7 +55,7 @@ def native_read(record: NativeStep) -> dict:
     h = record.time - (record.t0 + cnt[record.step_slot] * record.dt)
     if h < record.grid_tolerance * record.dt:
         h = 0.0
-    status = OBSERVE(record.observe)(record.flags, record.y, record.cnt, record.drv, record.prm, min(h, record.dt),
+    status = OBSERVE(record.observe)(record.kind, record.flags, record.y, record.cnt, record.drv, record.prm, min(h, record.dt),
                                      record.track_energy, record.obs)
     assert status == record.observed_ok
     obs = as_array(record.obs, ctypes.c_double, (L.N_OBS,))
@@ -72,7 +72,7 @@ def native_advance(record: NativeStep, t_end: float) -> int:
     assert record.ready and not record.held
     cnt = np.ctypeslib.as_array(ctypes.cast(record.cnt, ctypes.POINTER(ctypes.c_int64)), (L.N_CNT,))
     target = math.floor((t_end - record.t0) / record.dt + record.grid_tolerance)
-    status = ADVANCE(record.advance)(record.flags, record.y, record.cnt, record.drv, record.prm,
+    status = ADVANCE(record.advance)(record.kind, record.flags, record.y, record.cnt, record.drv, record.prm,
                                      target - int(cnt[record.step_slot]), record.track_energy)
     if status == RETURNED_OK:
         record.time = t_end

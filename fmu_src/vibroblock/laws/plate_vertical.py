@@ -1,0 +1,17 @@
+"""Vertical plate motion: the internal harmonic drive A sin(omega t) plus the external input plate_z, plate_v, plate_a.
+
+The external input is held at constant acceleration over a communication step (tau is
+the time since it was set), so a master's samples of a record are played as a piecewise
+parabola whose velocity is continuous where the master's samples are consistent.
+"""
+from numba import njit
+
+ID = 0
+
+
+@njit(inline="always")
+def motion(amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau):
+    """Plate height and velocity."""
+    z = amp * sin_phase + ext_z + tau * (ext_v + 0.5 * ext_a * tau)
+    v = amp * omega * cos_phase + ext_v + ext_a * tau
+    return z, v
