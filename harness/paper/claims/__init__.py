@@ -1,4 +1,4 @@
-"""The claims of DESIGN.md (C1-C8) and the paper's Fig. 1b, one module each.
+"""The claims of docs/claims.md (C1-C8) and the paper's Fig. 1b, one module each.
 
 Each module holds its claim's study (``study_cN(runner) -> Study``: runs -> measured
 numbers), its verdict criteria (``verdict_cN(measured)`` -> rows of the claims table;

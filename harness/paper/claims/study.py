@@ -268,7 +268,7 @@ def timing(wall_time: float, before: dict, after: dict) -> dict:
 
 @dataclass(frozen=True)
 class Claim:
-    """One claim of DESIGN.md as the report sees it: its study, the verdict rows computed
+    """One claim of docs/claims.md as the report sees it: its study, the verdict rows computed
     from what the study measured, the statement of each part and the figures of each part.
 
     ``verdicts(measured) -> list[Row]`` is None for a study that only draws a figure
