@@ -150,4 +150,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from harness.benchmarks import recorded
+
+    with recorded("core_and_fmu"):
+        main()

@@ -13,7 +13,7 @@ on the steady in-contact orbit at a crest of the corrugation (x_start = pi / (2 
 at the time the drive spring is relaxed (t0 = x_start / V_d).
 
 The grid: omega in [0.1, 1] and A in [0.3, 300], ``--grid`` points each, log-spaced (the
-ranges of Fig. 1c's benchmark).  What one point needs (issue 10, item 4): >= ``--cycles``
+ranges of Fig. 1c's benchmark).  What one point needs: >= ``--cycles``
 stick-slip cycles, or, where the block slides, >= ``--cycles`` corrugation wavelengths,
 after a transient of half a unit, with one unit more in the window, as in
 ``fig1c_paper_parameters``: (cycles + 1.5) units per point.  The units:
@@ -40,7 +40,7 @@ it with 10 minutes.  Saves ``<out>/fig5_paper.png`` and ``.csv``; ``--replot`` r
 the figure from the CSV.  With a cap long enough for every point to finish, the run's
 wall time is the diagram's.
 
-Measured figures only (README, "Choosing speed or accuracy"); nothing here is a timed test.
+Its figures go to docs/benchmarks.md (section fig5_paper); nothing here is a timed test.
 """
 from __future__ import annotations
 
@@ -297,4 +297,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from harness.benchmarks import recorded
+
+    with recorded("fig5_paper"):
+        main()

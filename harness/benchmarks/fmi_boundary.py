@@ -269,4 +269,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from harness.benchmarks import recorded
+
+    with recorded("fmi_boundary"):
+        main()

@@ -145,4 +145,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from harness.benchmarks import recorded
+
+    with recorded("scene_reductions"):
+        main()

@@ -93,4 +93,7 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from harness.benchmarks import recorded
+
+    with recorded("study_integrators"):
+        main()

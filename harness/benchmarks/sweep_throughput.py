@@ -164,4 +164,8 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from harness.benchmarks import recorded
+
+    with recorded("sweep_throughput"):
+        status = main()
+    raise SystemExit(status)

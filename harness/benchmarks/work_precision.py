@@ -450,4 +450,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from harness.benchmarks import recorded
+
+    with recorded("work_precision"):
+        main()

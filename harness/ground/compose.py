@@ -120,7 +120,7 @@ def communication_step_study(settings: StudySettings = StudySettings(), progress
     Rows: ``master, step_size``; ``max_z_error`` (largest height difference over the
     run); ``first_slip`` and its error; ``x_end`` and its error; ``phi`` (the paper's
     order parameter over the run, ``phi_integral(T) / (T V_d^2)``) and its relative
-    error; ``resets`` (Coulomb resets, a dt-dependent count, DESIGN.md); and the plate's
+    error; ``resets`` (Coulomb resets, a dt-dependent count, docs/claims.md); and the plate's
     largest height and velocity errors per step, ``|j| h^3/6`` and ``|j| h^2/2`` with
     ``|j| = A omega^3``.
     """

@@ -22,7 +22,7 @@ import numpy as np
 from harness.cosim.fmu import REPO_ROOT
 
 # Parameter sets a run can start from.  "scaled" keeps model A quasi-static while making a
-# stick-slip cycle affordable: stick ~5.2e3 tau_0, slip ~50 delta_0 (see DESIGN.md, Sec. 1).
+# stick-slip cycle affordable: stick ~5.2e3 tau_0, slip ~50 delta_0 (see docs/claims.md, Conventions).
 PRESETS: dict[str, dict[str, float]] = {
     "paper": {},
     "scaled": {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3},

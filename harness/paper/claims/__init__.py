@@ -1,4 +1,4 @@
-"""The claims of DESIGN.md (C1-C8) and the paper's Fig. 1b, one module each.
+"""The claims of docs/claims.md (C1-C8) and the paper's Fig. 1b, one module each.
 
 Each module holds its claim's study (``study_cN(runner) -> Study``: runs -> measured
 numbers), its verdict criteria (``verdict_cN(measured)`` -> rows of the claims table;
@@ -37,9 +37,8 @@ STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 # chains of dependent rounds (sweep, bisection, start ensemble) and their longest single
 # runs do not trail at the end while the cheap studies fill the gaps.  The order follows
 # the compute time of each claim's study under one reading in the main job at the default
-# resolution (README: C6 ~330 s; Fig. 1c ~300 s, whose runs of the paper's drive, up to
-# about 90 s each, are the job's longest single tasks; C6r ~240 s, C8 70-130 s, C3 ~65 s,
-# C4 ~40 s, C7 30-40 s, C5 15-20 s, then seconds).
+# resolution (docs/benchmarks.md, section "make run"; Fig. 1c's runs of the paper's drive
+# are the job's longest single tasks).
 COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "C8", "C3", "C4", "C7", "C5", "C2", "C1", "Fig1b")
 
 

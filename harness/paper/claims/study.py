@@ -159,20 +159,19 @@ class Runner:
         """A run of ``model`` under the runner's reading (parameters the study sets win).
 
         Without an ``integration`` of the study's own, model A runs with ``event_driven``
-        (exact flows with located events: agrees with the independent reference to
-        ~1e-9, and 2-5x cheaper than the paper's first-order scheme through the FMU) where
+        (exact flows with located events, cheaper and more accurate than the paper's
+        first-order scheme through the FMU: docs/benchmarks.md) where
         it applies, i.e. under the contact-force bound, else with the paper's
         ``symplectic_euler`` at dt = 4e-4.  Models B and C run with ``adaptive`` (rtol
         1e-6, atol 1e-8) at omega <= 20, A omega <= 16 and V_d <= 1, ``symplectic_euler``
         otherwise: the paper's scheme costs the same at every omega and A (its step is
         fixed), while ``adaptive`` pays for the plate's cycles (a step spans at most a
         sixteenth of one) and for the landings, whose violence grows with the plate's
-        speed A omega.  On the studies' runs (paper's plate, ``python -m
-        harness.benchmarks.study_integrators --full``) it costs 1.1-6x less inside those
-        limits and up to 7x more outside them (A = 3 at omega = 6.3: 2x more; A = 0.3 at
-        omega = 50: 4x more); with the same regime on every run measured inside them, it
-        is also the accurate one of the two.  V_d = 10 keeps the paper's scheme: there
-        the two disagree on the regime and no reference decides between them."""
+        speed A omega.  The limits come from the studies' runs measured both ways
+        (``python -m harness.benchmarks.study_integrators --full``; figures in
+        docs/benchmarks.md): inside them ``adaptive`` is the cheaper and, with the same
+        regime on every run, the accurate one of the two.  V_d = 10 keeps the paper's
+        scheme: there the two disagree on the regime and no reference decides between them."""
         parameters = {**self.reading.parameters(model), **dict(fields.pop("parameters", {}) or {})}
         if "integration" not in fields:
             if model == "A" and not parameters.get("coulomb_normal"):
@@ -268,7 +267,7 @@ def timing(wall_time: float, before: dict, after: dict) -> dict:
 
 @dataclass(frozen=True)
 class Claim:
-    """One claim of DESIGN.md as the report sees it: its study, the verdict rows computed
+    """One claim of docs/claims.md as the report sees it: its study, the verdict rows computed
     from what the study measured, the statement of each part and the figures of each part.
 
     ``verdicts(measured) -> list[Row]`` is None for a study that only draws a figure

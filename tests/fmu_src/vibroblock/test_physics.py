@@ -48,7 +48,7 @@ def test_stick_slip_without_vibration_matches_claim_c1():
     start = np.argmax(vx > 10 * v_creep)
     stop = start + np.argmax(vx[start:] < 10 * v_creep)
     # Resets quantise the slip into whole multiples of mu_s m g / k_t of travel:
-    # a few percent off the paper's energy argument (DESIGN.md).
+    # a few percent off the paper's energy argument (docs/claims.md, Conventions).
     assert x[stop] - x[start - 1] == pytest.approx(slip, rel=5e-2)
 
 

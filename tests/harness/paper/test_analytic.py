@@ -28,7 +28,7 @@ def test_restitution_matches_a_simulated_single_impact(k_n, gamma_n, m):
 def test_bouncing_floor_limits_and_the_design_values():
     assert bouncing_floor(1.0) == 0.0  # an elastic ball bounces on any vibration
     assert bouncing_floor(0.0) == pytest.approx(math.pi)  # a plastic one needs A omega^2 = pi g
-    # DESIGN.md: for A = 10, omega* = 0.093, 0.131, 0.186, 0.262 at gamma_n = 0.035 ... 0.28.
+    # docs/physics.md, Sec. 8: for A = 10, omega* = 0.093, 0.131, 0.186, 0.262 at gamma_n = 0.035 ... 0.28.
     found = [float(bouncing_floor_omega(10.0, gamma_n=g)) for g in (0.035, 0.07, 0.14, 0.28)]
     assert found == pytest.approx([0.093, 0.131, 0.186, 0.262], abs=1e-3)
 
