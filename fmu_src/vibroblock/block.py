@@ -321,7 +321,7 @@ class Block:
     def _contact_energy(self, penetration: float) -> float:
         """The contact law's potential U(delta), 0 out of contact (the law's Python function:
         an output read compiles nothing)."""
-        potential = law("contact", self.settings.readings.get("contact", 0)).module.potential.py_func
+        potential = law("contact", self.settings.readings.get("contact_law", 0)).module.potential.py_func
         return float(potential(penetration, self.prm)) if penetration > 0.0 else 0.0
 
     def _stored_energy(self, obs, t):
@@ -332,7 +332,7 @@ class Block:
         p = self.parameters
         x, vx, vz, shear = obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F]
         stretch = x - p["V_d"] * t
-        friction = float(law("friction", self.settings.readings.get("friction", 0)).module.energy.py_func(shear, self.prm))
+        friction = float(law("friction", self.settings.readings.get("friction_law", 0)).module.energy.py_func(shear, self.prm))
         return (0.5 * p["m"] * (vx * vx + vz * vz) + 0.5 * p["k_d"] * stretch * stretch
                 + friction + self._contact_energy(obs[L.O_PENETRATION]))
 

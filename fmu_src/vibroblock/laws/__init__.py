@@ -12,10 +12,10 @@ The axes, their FMU parameter and the functions every law of the axis brings:
 ============  ================  ===============================================================
 axis          parameter         functions
 ============  ================  ===============================================================
-contact       ``contact``       force(delta, u_n, prm), elastic(delta, prm), dissipation(delta,
+contact       ``contact_law``   force(delta, u_n, prm), elastic(delta, prm), dissipation(delta,
                                 u_n, prm), potential(delta, prm); CONSERVATIVE: the elastic
                                 force is -grad(potential) on a curved plate
-friction      ``friction``      spring_force(F, prm), energy(F, prm), released(F0, F1, prm),
+friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F0, F1, prm),
                                 rule(F, delta, N_b, prm)
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N
 plate         (one law)         motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau)
@@ -51,8 +51,8 @@ class Axis:
 # Bits 0-2 of kind hold the variant, 3 and 5 the readings formulation and flight
 # (vibroblock.readings); the Coulomb bound keeps bit 4, where it was a reading.
 AXES = {
-    "contact": Axis("contact", "contact", "contact_", 6, 2),
-    "friction": Axis("friction", "friction", "friction_", 8, 2),
+    "contact": Axis("contact", "contact_law", "contact_", 6, 2),
+    "friction": Axis("friction", "friction_law", "friction_", 8, 2),
     "bound": Axis("bound", "coulomb_normal", "bound_", 4, 1),
     "plate": Axis("plate", "plate_motion", "plate_", 10, 0),
 }

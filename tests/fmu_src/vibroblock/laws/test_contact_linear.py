@@ -22,7 +22,7 @@ def elastic_force(kind, x, z, prm):
 def bare_contact(contact):
     """kind and prm of model B with only the contact's spring acting (slope 1 at x = 0)."""
     block = Block("B", "rk4", 1, g=0.0, k_d=0.0, gamma_n=0.0, gamma_t=0.0, k_t=0.0, A_x=50.0, omega_x=0.02,
-                  contact=contact, z_start=-1.0)
+                  contact_law=contact, z_start=-1.0)
     block.start()
     return block.settings.kind, block.prm
 
@@ -59,7 +59,7 @@ def flank_swing(contact, slope, gamma_t, horizon=2e4, window=1000.0):
     k_d = slope / -x0  # the drive spring (anchored at 0, V_d = 0) balances the slope: -k_d x0 = m g tan(a)
     cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
     block = Block("B", "rk4", 1, dt=1e-2, k_t=0.0, gamma_t=gamma_t, k_d=k_d, V_d=0.0, A_x=a_x, omega_x=w_x,
-                  contact=contact, x_start=x0 + 0.5, z_start=a_x * math.sin(phase) - 1.0 / cos_a ** 2)
+                  contact_law=contact, x_start=x0 + 0.5, z_start=a_x * math.sin(phase) - 1.0 / cos_a ** 2)
     block.start()
 
     def swing(t0):

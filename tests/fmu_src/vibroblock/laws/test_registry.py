@@ -71,7 +71,7 @@ def test_the_linear_laws_agree_off_a_curved_plate():
     the same bits (model A)."""
     outputs = []
     for contact in ("linear", "linear_along_normal"):
-        block = Block("A", "rk4", 0, True, A=2.5, omega=0.9, dt=4e-3, contact=contact)
+        block = Block("A", "rk4", 0, True, A=2.5, omega=0.9, dt=4e-3, contact_law=contact)
         block.start()
         block.advance_to(40.0)
         outputs.append(block.outputs())
