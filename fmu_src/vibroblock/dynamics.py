@@ -40,10 +40,11 @@ from numba import njit
 
 from .laws import bound_normal, contact_dissipation, contact_elastic, contact_force, friction_spring_force
 from .laws import friction_rule as law_friction_rule
-from .laws.plate_vertical import motion as plate_motion  # noqa: F401  (the one plate law, for the integrators)
+# The one plate law, for the integrators.
+from .laws.plate_vertical import acceleration as plate_acceleration, motion as plate_motion  # noqa: F401
 from .layout import P_GT, P_KD, P_VD
 from .laws import contact_conservative
-from .models import curvature, load, profile
+from .models import curvature, frame, load, profile  # noqa: F401  (frame: the surface's, for the integrators)
 from .readings import free_flight, tangent_frame
 
 
@@ -71,11 +72,7 @@ def surface_contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     ``flight = free`` off contact it still returns the surface's frame (u_t, cos a, sin a),
     the frame of a contact phase continued across delta = 0 (the adaptive integrator's)."""
     height, slope = profile(kind, x, prm)
-    if slope == 0.0:  # flat plate: skip the square root (model A's hot path)
-        cos_a, sin_a = 1.0, 0.0
-    else:
-        cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
-        sin_a = slope * cos_a
+    cos_a, sin_a = frame(slope)
     if tangent_frame(kind):  # state (x, zeta, u, w): the plate moves along the local normal
         penetration = plate_z - z
         u_n = vz - plate_v

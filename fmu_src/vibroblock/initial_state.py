@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 from . import layout as L
+from .models import frame
 from .orbits import steady_orbit
 from .settings import ModelError, Settings
 
@@ -53,8 +54,7 @@ def point_to_frame(variant, prm, x, z, vx, vz):
     (docs/physics.md, Sec. 4): zeta = (z - h) cos a, u = vx / cos a,
     w = cos a (vz - u sin a - zeta h'' u sin a cos a)."""
     height, slope = variant.profile(x, prm)
-    cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
-    sin_a = slope * cos_a
+    cos_a, sin_a = frame.py_func(slope)
     zeta, u = (z - height) * cos_a, vx / cos_a
     return zeta, u, cos_a * (vz - u * sin_a - zeta * variant.curvature(x, prm) * u * sin_a * cos_a)
 
@@ -63,8 +63,7 @@ def frame_to_point(variant, prm, x, zeta, u, w):
     """The point (z, vx, vz) of a tangent-frame state (x, zeta, u, w): z = h + zeta / cos a,
     vx = u cos a, vz = u sin a + w / cos a + zeta h'' u sin a cos a."""
     height, slope = variant.profile(x, prm)
-    cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
-    sin_a = slope * cos_a
+    cos_a, sin_a = frame.py_func(slope)
     return (height + zeta / cos_a, u * cos_a,
             u * sin_a + w / cos_a + zeta * variant.curvature(x, prm) * u * sin_a * cos_a)
 

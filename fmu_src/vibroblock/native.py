@@ -33,6 +33,9 @@ names the version both sides check.
 from __future__ import annotations
 
 import ctypes
+import math
+
+import numpy as np
 
 from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import carray, cfunc, types  # noqa: E402
@@ -40,6 +43,7 @@ from numba import carray, cfunc, types  # noqa: E402
 from . import layout as L  # noqa: E402
 from .integrators import adaptive, event_driven, fixed_step  # noqa: E402
 from . import scenes  # noqa: E402  (after the integrators, which register its scheme)
+from .observation import maps_to_point  # noqa: E402
 
 LAYOUT = 3  # bump with any change of NativeStep's fields
 
@@ -92,6 +96,76 @@ class NativeStep(ctypes.Structure):
         ("outputs", ctypes.c_void_p),  # int64 pairs (value reference, slot or SURFACE_Z / ZERO)
         ("n_outputs", ctypes.c_int64),
     ]
+
+
+# The outputs that are plain entries of the observation in every reading: a native front
+# end may read them without Python (``Block._observables`` is the reference).  The Boolean
+# contact and the Integer slip_count are stored as 0.0/1.0 and a whole count; the front end
+# converts them as _observables does (!= 0, truncation).
+OBSERVED_OUTPUTS = {"x": L.O_X, "friction_force": L.O_FRICTION, "normal_force": L.O_NORMAL,
+                    "phi_integral": L.O_PHI, "penetration": L.O_PENETRATION, "work_input": L.O_WORK,
+                    "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "slip_count": L.O_SLIPS}
+# ... and in the model's own reading, where the state is the point itself.
+OBSERVED_POINT = {"z": L.O_Z, "vx": L.O_VX, "vz": L.O_VZ, "surface_z": SURFACE_Z}
+
+
+class NativeLink:
+    """A Block's side of the native front end: the ``NativeStep`` record it keeps up to date
+    (its time lives there, also when no front end drives it), and the outputs the front
+    end may read."""
+
+    def __init__(self, grid_tolerance: float):
+        self.record = NativeStep(layout=LAYOUT, returned_ok=RETURNED_OK, observed_ok=OBSERVED_OK,
+                                 step_slot=L.C_STEP, grid_tolerance=grid_tolerance, time=math.nan)
+        self.driven = False
+        self.output_refs: dict[str, int] = {}
+        self.outputs = np.zeros((0, 2), dtype=np.int64)  # kept alive while the record points at it
+
+    def attach(self, record: NativeStep, time_tolerance: float, output_refs: dict | None) -> None:
+        """Let a front end drive the block through ``record`` (its time moves there), with
+        ``time_tolerance`` the front end's match of a master's time to the block's.  The
+        record takes over the block's time; a record already driving another block is
+        simply re-pointed at this one.  The caller binds its kernels again."""
+        record.time, record.time_tolerance = self.record.time, time_tolerance
+        self.output_refs = dict(output_refs or {})
+        for name in ("layout", "returned_ok", "observed_ok", "step_slot", "grid_tolerance"):
+            setattr(record, name, getattr(self.record, name))
+        self.record, self.driven = record, True
+        record.ready = 0
+
+    def publish(self, block) -> None:
+        """Point the record at the block's bound kernel and arrays; ready once the run has
+        started."""
+        record = self.record
+        record.ready = 0
+        if not (self.driven and block.started):
+            return
+        settings, kernel = block.settings, block._kernel
+        entry = entry_address(kernel.advance, kernel.id)
+        record.advance = entry
+        record.kind = settings.kind
+        record.flags = settings.scene_flags(block.frozen_released)
+        record.y, record.cnt, record.drv, record.prm = (a.ctypes.data for a in (block.y, block.cnt, block.drv,
+                                                                                block.prm))
+        record.track_energy = int(block._track_energy)
+        record.step_budget = block._step_budget
+        record.t0, record.dt = block._grid
+        record.observe = entry_address(kernel.observe, kernel.id)
+        record.obs = block.obs.ctypes.data
+        self.outputs = self._observed_outputs(block)
+        record.outputs, record.n_outputs = self.outputs.ctypes.data, len(self.outputs)
+        record.ready = int(entry is not None)
+
+    def _observed_outputs(self, block) -> np.ndarray:
+        """(value reference, observation slot or SURFACE_Z / ZERO) of each output a front
+        end may read straight from the observation in this run."""
+        sources = dict(OBSERVED_OUTPUTS)
+        if not maps_to_point(block.settings):  # else z, vx, vz come from observation.as_point
+            sources.update(OBSERVED_POINT)
+        if not block.energy_balance:
+            sources["energy_residual"] = ZERO
+        pairs = [(self.output_refs[name], source) for name, source in sources.items() if name in self.output_refs]
+        return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
 # One factory per advance kernel, each compiling a cfunc for one method (the kernels take

@@ -44,7 +44,7 @@ from .integrators.fixed_step import OK, STOP, record_observation
 from .integrators.plate import drive_sin_cos, phase_after, plate_after, plate_at
 from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_M,
                      P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
-from .models import load, profile
+from .models import frame, load, profile
 
 RIGID, FROZEN, COULOMB = 1, 2, 4
 # The id of this scheme in the integrator registry (internal: chosen by the scene options).
@@ -118,11 +118,7 @@ def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, 
     x1 = x + h * vx1
     z1 = z + h * vz1
     height1, slope1 = profile(kind, x1, prm)
-    if slope1 == 0.0:
-        c1, s1 = 1.0, 0.0
-    else:
-        c1 = 1.0 / math.sqrt(1.0 + slope1 * slope1)
-        s1 = slope1 * c1
+    c1, s1 = frame(slope1)
     if frozen:  # model A: the prescribed vertical motion
         z1, vz1 = pz1 + height1 - frozen_pen1, pv1 + frozen_un1
     impact = impact_work = 0.0

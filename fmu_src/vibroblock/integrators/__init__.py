@@ -48,6 +48,7 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import typeof, types  # noqa: E402
 
 from . import adaptive, event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
+from ..laws import law
 from ..orbits import orbit_response
 from .fixed_step import NON_FINITE, OK, STOP
 
@@ -108,6 +109,19 @@ def _undamped_resonance(p: dict, model: str, name: str) -> str | None:
         return (f"{name} cannot drive an undamped contact (gamma_n = 0) at its own resonance omega = sqrt(k_n / m) "
                 f"= {p['omega']:g}: its closed-form contact flow has no steady part there (the oscillation grows "
                 f"without bound); give gamma_n > 0, another omega, or use adaptive")
+    return None
+
+
+def _event_driven_refuses(readings: dict) -> str | None:
+    """event_driven's flows are closed forms of linear oscillators and its Coulomb resets are
+    zeros of the oscillating contact force: it runs a contact law only if the law says it is
+    linear (a module constant ``LINEAR``), and the contact force's bound only."""
+    if readings["coulomb_normal"] == 1:
+        return "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 (applied_load)"
+    contact = law("contact", readings.get("contact_law", 0))
+    if not getattr(contact.module, "LINEAR", False):
+        return (f"integrates the closed-form flows of a linear contact law only, not contact_law = {contact.id} "
+                f"({contact.name}): its force is not linear in the penetration and its rate")
     return None
 
 
@@ -244,10 +258,7 @@ _RECORDS = (
                 check_step=_spring_dashpot_limit(4.0)),
     Integrator(2, "event_driven", "exact flows with located events (model A only)", models="A",
                force_evaluations=0, check_step=_undamped_resonance, advance=event_driven.advance,
-               observe=event_driven.observe, splits_bitwise=False,
-               unsupported_reading=lambda r: (
-                   "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 "
-                   "(applied_load)" if r["coulomb_normal"] == 1 else None)),
+               observe=event_driven.observe, splits_bitwise=False, unsupported_reading=lambda r: _event_driven_refuses(r)),
     _fixed_step(3, "implicit_contact", implicit_contact,
                 summary="contact spring-dashpots in closed form, stiff-stable", models="*", force_evaluations=2,
                 check_step=_implicit_contact_limit, statuses=_IMPLICIT_STATUSES,

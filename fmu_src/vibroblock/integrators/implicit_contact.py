@@ -80,7 +80,8 @@ import numpy as np
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from ..dynamics import contact, curvature_force
+from ..dynamics import contact, curvature_force, frame
+from ..laws import friction_energy
 from ..layout import P_GN, P_GT, P_KD, P_KN, P_KT, P_M, P_VD
 from ..models import load, profile
 
@@ -295,35 +296,23 @@ def contact_release(a, w2, b, d0, v0, span):
 
 # ---------------------------------------------------------------------- one step
 @njit(cache=True)
-def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, table,
-                          seg_len, seg_contact, track_energy):
-    """One step of length h from (x, z, vx, vz, F) at time t; the plate is at (pz0, pv0) at
-    t and (pz1, pv1) at t + h.  ``table`` holds ``step_propagators(prm, h)``; ``seg_len``,
-    ``seg_contact`` are scratch arrays of MAX_SEGMENTS entries.
-
-    Returns (status, x, z, vx, vz, F, d_phi, d_work, d_dissipated, d_normal): status 0,
-    or TOO_MANY_SWITCHES / TOO_FAST_FOR_CORRUGATION (the state is then not usable).
-    The friction rule at the new state is the caller's (as for every integrator).
-    """
+def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel):
+    """The soft forces at the midpoint, in the frame there (step 2 of the module doc), from
+    ``start`` = (delta, u_n, u_t, cos, sin) at the step's start.  Returns (status, (cos,
+    sin, turning rate Omega, slope at x + h vx), (normal force, tangential force, the
+    drive's pull at the start position less at the midpoint, load_x, load_z))."""
     m = prm[P_M]
-    k_n, g_n, k_t, g_t = prm[P_KN], prm[P_GN], prm[P_KT], prm[P_GT]
-    a_n, w2_n = 0.5 * g_n / m, k_n / m
-    a_t, w2_t = 0.5 * g_t / m, k_t / m
-    pen0, u_n0, u_t0, cos0, sin0, _ = contact(kind, x, z, vx, vz, pz0, pv0, prm)
-    plate_accel = (pv1 - pv0) / h
-
-    # -- soft forces at the midpoint, in the frame there ------------------------------
+    pen0, _, _, cos0, sin0 = start
     t_mid = t + 0.5 * h
     x_mid = x + 0.5 * h * vx
     slope_m = profile(kind, x_mid, prm)[1]
     slope_end = profile(kind, x + h * vx, prm)[1]
     cos_m, sin_m, turn_rate = 1.0, 0.0, 0.0
     if sin0 != 0.0 or slope_m != 0.0 or slope_end != 0.0:  # a flat plate skips all of this
-        cos_m = 1.0 / math.sqrt(1.0 + slope_m * slope_m)
-        sin_m = slope_m * cos_m
+        cos_m, sin_m = frame(slope_m)
         turn_rate = (math.atan(slope_end) - math.atan(sin0 / cos0)) / h
         if not abs(turn_rate * h) <= MAX_TURN_PER_STEP:
-            return TOO_FAST_FOR_CORRUGATION, x, z, vx, vz, shear, 0.0, 0.0, 0.0, 0.0
+            return TOO_FAST_FOR_CORRUGATION, (cos_m, sin_m, turn_rate, slope_end), (0.0, 0.0, 0.0, 0.0, 0.0)
     drive = -prm[P_KD] * (x_mid - prm[P_VD] * t_mid)
     drive_start = -prm[P_KD] * (x - prm[P_VD] * t_mid)
     load_x, load_z = load(kind, cos_m, sin_m, prm)
@@ -333,148 +322,171 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
         curving = curvature_force(kind, x_mid, pen0, cos_m, sin_m, prm)
         force_n -= curving * sin_m
         force_t += curving * cos_m
-    # Rate at which delta changes as the tangent line under the block turns
-    # (d delta/dt = -u_n - delta tan(alpha) Omega), taken at the predicted midpoint.
-    delta_rate = 0.0
-    in_contact = pen0 > 0.0 or (pen0 == 0.0 and u_n0 < 0.0)
-    if turn_rate != 0.0:
-        # Midpoint values of u_t and delta from half-step flows in the starting contact
-        # state (the O(h^2) accuracy the midpoint rule needs), with the turning terms.
-        turning = (sin_m / cos_m) * turn_rate
-        pen_rate0 = -u_n0 - turning * pen0
-        coriolis0 = turn_rate * u_n0
-        if in_contact:
-            ut_mid = _apply(_row(table, HALF + SHEAR_CONTACT), w2_t, shear, u_t0, force_t / m + coriolis0)[1]
-        else:
-            ut_mid = _apply(_row(table, HALF + SHEAR_FLIGHT), 0.0, 0.0, u_t0, force_t / m + coriolis0)[1]
-        force_n -= m * turn_rate * ut_mid  # centripetal
-        if in_contact:
-            b_mid = (-g_n * turning * pen0 - force_n) / m
-            pen_mid = _apply(_row(table, HALF + NORMAL_CONTACT), w2_n, pen0, pen_rate0, b_mid)[0]
-        else:
-            pen_mid = pen0 + 0.5 * h * pen_rate0 - 0.125 * h * h * force_n / m
-        delta_rate = -turning * pen_mid
+    return 0, (cos_m, sin_m, turn_rate, slope_end), (force_n, force_t, drive_start - drive, load_x, load_z)
 
-    # -- normal direction: exact flow, contact switches located ---------------------
-    d, v = pen0, delta_rate - u_n0  # delta and its rate
+
+@njit(cache=True)
+def _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t):
+    """On a turning frame: the normal force with the centripetal term, and the rate at which
+    delta changes as the tangent line under the block turns (d delta/dt = -u_n - delta
+    tan(alpha) Omega), from half-step flows in the starting contact state (the O(h^2)
+    accuracy the midpoint rule needs), with the turning terms."""
+    m = prm[P_M]
+    pen0, u_n0, u_t0, _, _ = start
+    cos_m, sin_m, turn_rate, _ = frame_m
+    turning = (sin_m / cos_m) * turn_rate
+    pen_rate0 = -u_n0 - turning * pen0
+    coriolis0 = turn_rate * u_n0
+    if in_contact:
+        ut_mid = _apply(_row(table, HALF + SHEAR_CONTACT), prm[P_KT] / m, shear, u_t0, force_t / m + coriolis0)[1]
+    else:
+        ut_mid = _apply(_row(table, HALF + SHEAR_FLIGHT), 0.0, 0.0, u_t0, force_t / m + coriolis0)[1]
+    force_n -= m * turn_rate * ut_mid  # centripetal
+    if in_contact:
+        b_mid = (-prm[P_GN] * turning * pen0 - force_n) / m
+        pen_mid = _apply(_row(table, HALF + NORMAL_CONTACT), prm[P_KN] / m, pen0, pen_rate0, b_mid)[0]
+    else:
+        pen_mid = pen0 + 0.5 * h * pen_rate0 - 0.125 * h * h * force_n / m
+    return force_n, -turning * pen_mid
+
+
+@njit(cache=True)
+def _contact_segment(prm, table, h, d, v, b, span, track_energy, plate):
+    """A contact segment of the normal flow from delta = d, delta' = v under the constant
+    forcing b, up to a release within ``span``: (tau, released, delta, delta', the plate's
+    work, the dashpot's dissipation); tau = -2 if the contact is too stiff to search.
+    ``plate`` = (plate velocity at the segment's start, the step's plate acceleration,
+    cos, the normal force, delta's turning rate)."""
+    m, k_n, g_n = prm[P_M], prm[P_KN], prm[P_GN]
+    a_n, w2_n = 0.5 * g_n / m, k_n / m
+    tau = contact_release(a_n, w2_n, b, d, v, span)
+    if tau == -2.0:
+        return tau, False, d, v, 0.0, 0.0
+    switch = tau >= 0.0
+    if not switch:
+        tau = span
+    prop = _row(table, NORMAL_CONTACT) if tau == h else oscillator_flow(a_n, w2_n, tau)
+    d1, v1 = _apply(prop, w2_n, d, v, b)
+    work = dissipated = 0.0
+    if track_energy:
+        # Exact for this flow: impulse J0 and first moment J1 of N = -m delta'' - f_n,
+        # dashpot dissipation from the energy identity.
+        plate_v, plate_accel, cos_m, force_n, delta_rate = plate
+        change = d1 - d
+        j0 = -m * (v1 - v) - force_n * tau
+        j1 = -m * (tau * v1 - change) - 0.5 * force_n * tau * tau
+        work = cos_m * (plate_v * j0 + plate_accel * j1)
+        oscillator_energy = 0.5 * m * (v1 - v) * (v1 + v) + 0.5 * k_n * (d1 - d) * (d1 + d)
+        dissipated = (g_n * delta_rate * delta_rate * tau - (g_n * delta_rate + force_n) * change
+                      - oscillator_energy)
+    return tau, switch, 0.0 if switch else d1, v1, work, dissipated
+
+
+@njit(cache=True)
+def _normal_flow(prm, table, h, d, v, in_contact, forces, segments, track_energy):
+    """Step 3: the normal direction's exact flow over the step from delta = d, delta' = v,
+    the contact switches located; ``forces`` = (normal force, delta's turning rate, cos,
+    plate velocity at the start, plate acceleration).  Fills ``segments`` = (lengths,
+    in contact) and returns (status, segments, delta, delta', work, dissipated)."""
+    m, g_n = prm[P_M], prm[P_GN]
+    force_n, delta_rate, cos_m, pv0, plate_accel = forces
+    seg_len, seg_contact = segments
     elapsed, n_seg = 0.0, 0
-    work = dissipated = e_normal = 0.0
+    work = dissipated = 0.0
     while True:
         span = h - elapsed
         if span <= 0.0:
             break
         if n_seg == MAX_SEGMENTS:
-            return TOO_MANY_SWITCHES, x, z, vx, vz, shear, 0.0, 0.0, 0.0, 0.0
+            return TOO_MANY_SWITCHES, n_seg, d, v, work, dissipated
         if in_contact:
-            b = (g_n * delta_rate - force_n) / m
-            tau = contact_release(a_n, w2_n, b, d, v, span)
+            tau, switch, d1, v1, d_work, d_dissipated = _contact_segment(
+                prm, table, h, d, v, (g_n * delta_rate - force_n) / m, span, track_energy,
+                (pv0 + plate_accel * elapsed, plate_accel, cos_m, force_n, delta_rate))
             if tau == -2.0:
-                return TOO_MANY_SWITCHES, x, z, vx, vz, shear, 0.0, 0.0, 0.0, 0.0
-            switch = tau >= 0.0
-            if not switch:
-                tau = span
-            if tau == h:
-                prop = _row(table, NORMAL_CONTACT)
-            else:
-                prop = oscillator_flow(a_n, w2_n, tau)
-            d1, v1 = _apply(prop, w2_n, d, v, b)
-            if track_energy:
-                # Exact for this flow: impulse J0 and first moment J1 of N = -m delta'' - f_n,
-                # dashpot dissipation and normal-spring work from the energy identity.
-                change = d1 - d
-                j0 = -m * (v1 - v) - force_n * tau
-                j1 = -m * (tau * v1 - change) - 0.5 * force_n * tau * tau
-                work += cos_m * ((pv0 + plate_accel * elapsed) * j0 + plate_accel * j1)
-                oscillator_energy = 0.5 * m * (v1 - v) * (v1 + v) + 0.5 * k_n * (d1 - d) * (d1 + d)
-                dissipated += (g_n * delta_rate * delta_rate * tau
-                               - (g_n * delta_rate + force_n) * change - oscillator_energy)
-                spring_integral = (m * b * tau - m * (v1 - v) - g_n * change) / k_n
-                e_normal += 0.5 * k_n * change * (d1 + d) - k_n * delta_rate * spring_integral
-            if switch:
-                d1 = 0.0
+                return TOO_MANY_SWITCHES, n_seg, d, v, work, dissipated
+            work += d_work
+            dissipated += d_dissipated
         else:
             b = -force_n / m
             tau = flight_landing(d, v, b, span)
             switch = tau >= 0.0
             if not switch:
                 tau = span
-            d1 = d + tau * (v + 0.5 * b * tau)
+            d1 = 0.0 if switch else d + tau * (v + 0.5 * b * tau)
             v1 = v + b * tau
-            if switch:
-                d1 = 0.0
         seg_len[n_seg] = tau
         seg_contact[n_seg] = in_contact
         n_seg += 1
         d, v = d1, v1
         elapsed += tau
-        if switch:
-            in_contact = not in_contact
-            # Grazing release with the forces still pressing in: stay in contact.
-            if not in_contact and v == 0.0 and -force_n > 0.0:
-                in_contact = True
-        else:
+        if not switch:
             break
-    pen1 = d
-    normal_travel = delta_rate * h - (pen1 - pen0)  # integral of u_n over the step
-    u_n1 = delta_rate - v
+        in_contact = not in_contact
+        # Grazing release with the forces still pressing in: stay in contact.
+        if not in_contact and v == 0.0 and -force_n > 0.0:
+            in_contact = True
+    return 0, n_seg, d, v, work, dissipated
 
-    # -- tangential direction over the same segments --------------------------------
-    # The drive spring pulls along the tangent with stiffness k_d cos^2 as the block
-    # travels: that part joins the exact flow (held explicit, it resonates with an
-    # under-resolved tangential oscillation once dt sqrt(k_t/m) > pi); the rest of the
-    # drive is taken at the step's start position and mid time, plus its pull through
-    # the normal travel on a slope (at the mid value, half the step's travel).
-    k_drive = prm[P_KD] * cos_m * cos_m
-    force_t += (m * turn_rate * normal_travel / h  # Coriolis, with the step's mean u_n
-                + (drive_start - drive) * cos_m + prm[P_KD] * cos_m * sin_m * 0.5 * normal_travel)
-    flat = cos_m == 1.0  # the table's tangential rows hold k_d at cos = 1
-    w2_contact, w2_flight = (k_t + k_drive) / m, k_drive / m
-    f, u = shear, u_t0
-    travel = 0.0
+
+@njit(cache=True)
+def _plate_impulse(prm, tau, u, u1, y1, change, b, w2, k_drive):
+    """Impulse and first moment over a tangential segment of the contact's tangential force
+    T = -k_t F - gamma_t u_t: T = m u' - m b + k_drive y, so both follow from the flow's
+    ends and the oscillator's integrals m w2 (Y0, Y1) of y and t y."""
+    m = prm[P_M]
+    a_t = 0.5 * prm[P_GT] / m
+    impulse = m * (u1 - u) - m * b * tau
+    moment = m * (tau * u1 - change) - 0.5 * m * b * tau * tau
+    if k_drive != 0.0:
+        share = k_drive / (m * w2)
+        y_integral = share * (m * b * tau - m * (u1 - u) - m * 2.0 * a_t * change)
+        impulse += y_integral
+        moment += share * (0.5 * m * b * tau * tau - m * (tau * u1 - change)
+                           - m * 2.0 * a_t * (tau * y1 - y_integral / k_drive))
+    return impulse, moment
+
+
+@njit(cache=True)
+def _tangential_flow(kind, prm, table, h, start, forces, segments, track_energy, totals):
+    """Step 4: the tangential direction's exact flow over the normal flow's segments, from
+    ``start`` = (F, u_t): F in contact (both springs pull, the drive's by the travel since
+    the step began), the free travel in flight; a detachment inside the step releases F.
+    ``forces`` = (tangential force, the drive's stiffness along the tangent, sin, plate
+    velocity at the start, plate acceleration, whether cos = 1: the table's tangential rows
+    hold k_d), ``totals`` = (work, dissipated) so far.
+    Returns (F, u_t, travel, work, dissipated)."""
+    m = prm[P_M]
+    force_t, k_drive, sin_m, pv0, plate_accel, flat = forces
+    seg_len, seg_contact, n_seg = segments
+    work, dissipated = totals
+    a_t = 0.5 * prm[P_GT] / m
+    w2_contact, w2_flight = (prm[P_KT] + k_drive) / m, k_drive / m
+    f, u = start
+    travel = elapsed = 0.0
     was_contact = seg_contact[0]
-    elapsed = 0.0
     for i in range(n_seg):
-        tau = seg_len[i]
-        engaged = seg_contact[i]
+        tau, engaged = seg_len[i], seg_contact[i]
         if was_contact and not engaged:  # detached inside the step: the spring is released
             if track_energy:
-                dissipated += 0.5 * k_t * f * f
+                dissipated += friction_energy(kind, f, prm)
             f = 0.0
         was_contact = engaged
-        # Oscillator y'' + 2 a_t y' + w2 y = b with y = F in contact (both springs pull,
-        # the drive's by the travel since the step began), the free travel in flight.
+        # Oscillator y'' + 2 a_t y' + w2 y = b with y = F in contact, the free travel in flight.
         if engaged:
-            w2, y0 = w2_contact, f
+            w2, y0, row = w2_contact, f, SHEAR_CONTACT
             b = (force_t - k_drive * (travel - f)) / m
-            if tau == h and flat:
-                prop = _row(table, SHEAR_CONTACT)
-            else:
-                prop = oscillator_flow(a_t, w2, tau)
         else:
-            w2, y0 = w2_flight, 0.0
+            w2, y0, row = w2_flight, 0.0, SHEAR_FLIGHT
             b = (force_t - k_drive * travel) / m
-            if tau == h and flat:
-                prop = _row(table, SHEAR_FLIGHT)
-            else:
-                prop = oscillator_flow(a_t, w2, tau)
+        prop = _row(table, row) if tau == h and flat else oscillator_flow(a_t, w2, tau)
         y1, u1 = _apply(prop, w2, y0, u, b)
         change = y1 - y0
         if track_energy:
             dissipated += (m * b * change - 0.5 * m * (u1 - u) * (u1 + u)
                            - 0.5 * m * w2 * (y1 - y0) * (y1 + y0))
-            if sin_m != 0.0:
-                # Work of the contact's tangential force T = -k_t F - gamma_t u_t through the
-                # plate's vertical velocity (linear over the step, as in the step's flow):
-                # T = m u' - m b + k_drive y, so its impulse and first moment follow from the
-                # flow's ends and the oscillator's integrals m w2 (Y0, Y1) of y and t y.
-                impulse = m * (u1 - u) - m * b * tau
-                moment = m * (tau * u1 - change) - 0.5 * m * b * tau * tau
-                if k_drive != 0.0:
-                    share = k_drive / (m * w2)
-                    y_integral = share * (m * b * tau - m * (u1 - u) - m * 2.0 * a_t * change)
-                    impulse += y_integral
-                    moment += share * (0.5 * m * b * tau * tau - m * (tau * u1 - change)
-                                       - m * 2.0 * a_t * (tau * y1 - y_integral / k_drive))
+            if sin_m != 0.0:  # the tangential force's work through the plate's vertical velocity
+                impulse, moment = _plate_impulse(prm, tau, u, u1, y1, change, b, w2, k_drive)
                 work += sin_m * ((pv0 + plate_accel * elapsed) * impulse + plate_accel * moment)
         if engaged:
             f = y1
@@ -483,24 +495,64 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
         elapsed += tau
     if not seg_contact[n_seg - 1]:
         f = 0.0
-    u_t1 = u
+    return f, u, travel, work, dissipated
 
-    # -- back to fixed axes at the new position --------------------------------------
+
+@njit(cache=True)
+def implicit_contact_step(kind, prm, state, t, h, plate, ctx, track_energy):
+    """One step of length h from ``state`` = (x, z, vx, vz, F) at time t; ``plate`` =
+    (height, velocity) at t and at t + h.  ``ctx`` holds ``step_propagators(prm, h)`` and
+    the scratch arrays of MAX_SEGMENTS entries for the segments' lengths and contact states.
+
+    Returns (status, x, z, vx, vz, F, d_phi, d_work, d_dissipated): status 0, or
+    TOO_MANY_SWITCHES / TOO_FAST_FOR_CORRUGATION (the state is then not usable).
+    The friction rule at the new state is the caller's (as for every integrator).
+    """
+    x, z, vx, vz, shear = state
+    pz0, pv0, pz1, pv1 = plate
+    table, seg_len, seg_contact = ctx
+    pen0, u_n0, u_t0, cos0, sin0, _ = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    start = (pen0, u_n0, u_t0, cos0, sin0)
+    plate_accel = (pv1 - pv0) / h
+    status, frame_m, forces = _soft_forces(kind, prm, x, vx, t, h, start, plate_accel)
+    if status != 0:
+        return status, x, z, vx, vz, shear, 0.0, 0.0, 0.0
+    cos_m, sin_m, turn_rate, slope_end = frame_m
+    force_n, force_t, drive_lag, load_x, load_z = forces
+    delta_rate = 0.0
+    in_contact = pen0 > 0.0 or (pen0 == 0.0 and u_n0 < 0.0)
+    if turn_rate != 0.0:
+        force_n, delta_rate = _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t)
+
+    status, n_seg, pen1, v, work, dissipated = _normal_flow(
+        prm, table, h, pen0, delta_rate - u_n0, in_contact, (force_n, delta_rate, cos_m, pv0, plate_accel),
+        (seg_len, seg_contact), track_energy)
+    if status != 0:
+        return status, x, z, vx, vz, shear, 0.0, 0.0, 0.0
+    normal_travel = delta_rate * h - (pen1 - pen0)  # integral of u_n over the step
+    u_n1 = delta_rate - v
+
+    # The drive spring pulls along the tangent with stiffness k_d cos^2 as the block
+    # travels: that part joins the exact flow (held explicit, it resonates with an
+    # under-resolved tangential oscillation once dt sqrt(k_t/m) > pi); the rest of the
+    # drive is taken at the step's start position and mid time, plus its pull through
+    # the normal travel on a slope (at the mid value, half the step's travel).
+    k_drive = prm[P_KD] * cos_m * cos_m
+    force_t += (prm[P_M] * turn_rate * normal_travel / h  # Coriolis, with the step's mean u_n
+                + drive_lag * cos_m + prm[P_KD] * cos_m * sin_m * 0.5 * normal_travel)
+    f, u_t1, travel, work, dissipated = _tangential_flow(
+        kind, prm, table, h, (shear, u_t0), (force_t, k_drive, sin_m, pv0, plate_accel, cos_m == 1.0),
+        (seg_len, seg_contact, n_seg),
+        track_energy, (work, dissipated))
+
+    # Step 5: back to fixed axes at the new position.  The step's frame has turned by
+    # Omega h = alpha(x + h vx) - alpha(x), which differs from alpha(x1) - alpha(x) by
+    # O(h^2).  (u_t, u_n) are components in that frame, and delta is measured across it:
+    # read both back in it (delta / cos gives the vertical gap, which is frame-free), so
+    # the error stays O(h^3) per step.
     x1 = x + cos_m * travel - sin_m * normal_travel
     height1, slope1 = profile(kind, x1, prm)
-    if slope1 == 0.0:
-        cos1, sin1 = 1.0, 0.0
-    else:
-        cos1 = 1.0 / math.sqrt(1.0 + slope1 * slope1)
-        sin1 = slope1 * cos1
-    # The step's frame has turned by Omega h = alpha(x + h vx) - alpha(x), which differs
-    # from alpha(x1) - alpha(x) by O(h^2).  (u_t, u_n) are components in that frame, and
-    # delta is measured across it: read both back in it (delta / cos gives the vertical
-    # gap, which is frame-free), so the error stays O(h^3) per step.
-    cos_e, sin_e = cos1, sin1
-    if turn_rate != 0.0 or slope_end != slope1:
-        cos_e = 1.0 / math.sqrt(1.0 + slope_end * slope_end)
-        sin_e = slope_end * cos_e
+    cos_e, sin_e = frame(slope_end if turn_rate != 0.0 or slope_end != slope1 else slope1)
     z1 = pz1 + height1 - pen1 / cos_e
     vx1 = u_t1 * cos_e - u_n1 * sin_e
     vz1 = pv1 + u_t1 * sin_e + u_n1 * cos_e
@@ -508,9 +560,9 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
     vd = prm[P_VD]
     d_phi = 0.5 * h * ((vx - vd) * (vx - vd) + (vx1 - vd) * (vx1 - vd))
     if track_energy:
-        work += prm[P_KD] * (vd * t_mid - 0.5 * (x + x1)) * vd * h  # the drive's far end
+        work += prm[P_KD] * (vd * (t + 0.5 * h) - 0.5 * (x + x1)) * vd * h  # the drive's far end
         work += load_x * (x1 - x) + load_z * (z1 - z)  # the load, constant over the step
-    return 0, x1, z1, vx1, vz1, f, d_phi, work, dissipated, e_normal
+    return 0, x1, z1, vx1, vz1, f, d_phi, work, dissipated
 
 
 # ---------------------------------------------------------------------- the scheme
@@ -524,10 +576,9 @@ def prepare(kind, flags, drv, prm, h):
 def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
     # The step is h exactly (the propagator table's); the grid times' difference would
     # carry the rounding of large t.
-    table, seg_len, seg_contact = ctx
     pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
-    status, x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = implicit_contact_step(
-        kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, table, seg_len, seg_contact, track_energy)
+    status, x, z, vx, vz, shear, d_phi, d_work, d_dissipated = implicit_contact_step(
+        kind, prm, (x, z, vx, vz, shear), t, h, (pz0, pv0, pz1, pv1), ctx, track_energy)
     contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-    return (status, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated,
-            d_normal)
+    # (the normal spring's energy is booked as its potential at observation time: no increment)
+    return (status, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, 0.0)

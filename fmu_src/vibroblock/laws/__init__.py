@@ -14,11 +14,13 @@ axis          parameter         functions
 ============  ================  ===============================================================
 contact       ``contact_law``   force(delta, u_n, prm), elastic(delta, prm), dissipation(delta,
                                 u_n, prm), potential(delta, prm); CONSERVATIVE: the elastic
-                                force is -grad(potential) on a curved plate
+                                force is -grad(potential) on a curved plate; LINEAR: the
+                                force is linear in (delta, u_n) (event_driven needs it)
 friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F0, F1, prm),
                                 rule(F, delta, N_b, prm)
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N
-plate         (one law)         motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau)
+plate         (one law)         motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau),
+                                acceleration(A, omega, sin, ext_a)
 ============  ================  ===============================================================
 
 A run's laws are part of the kernels' ``kind`` (``vibroblock.readings``: a few bits per

@@ -5,12 +5,10 @@ the paper's "mu_s m g" of Sec. III A extended to a corrugated plate.  It does no
 the plate's vibration (claim C2 holds by construction).  With the drive spring's share it
 can self-lock on a flank with tan a >= 1 / mu_s (docs/physics.md).
 """
-import math
-
 from numba import njit
 
 from ..layout import P_KD, P_VD
-from ..models import load, profile
+from ..models import frame, load, profile
 
 ID = 1
 
@@ -18,11 +16,6 @@ ID = 1
 @njit(inline="always")
 def normal(kind, contact_normal, x, t, prm):
     """N_a = -(load + drive spring) . n at abscissa x and time t."""
-    slope = profile(kind, x, prm)[1]
-    if slope == 0.0:
-        cos_a, sin_a = 1.0, 0.0
-    else:
-        cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
-        sin_a = slope * cos_a
+    cos_a, sin_a = frame(profile(kind, x, prm)[1])
     load_x, load_z = load(kind, cos_a, sin_a, prm)
     return load_x * sin_a - load_z * cos_a - prm[P_KD] * (x - prm[P_VD] * t) * sin_a

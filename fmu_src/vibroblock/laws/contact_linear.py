@@ -14,6 +14,7 @@ from numba import njit
 from ..layout import P_GN, P_KN
 
 ID = 0
+LINEAR = True  # linear in (delta, u_n): event_driven's closed-form flows run it
 CONSERVATIVE = True  # the elastic force is -grad(potential), curvature term included
 
 

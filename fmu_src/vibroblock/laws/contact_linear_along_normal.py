@@ -12,6 +12,7 @@ from numba import njit
 from . import contact_linear
 
 ID = 1
+LINEAR = True  # linear in (delta, u_n): event_driven's closed-form flows run it
 CONSERVATIVE = False  # no curvature term: the force stays along the normal
 
 force = contact_linear.force

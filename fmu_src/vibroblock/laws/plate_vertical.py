@@ -15,3 +15,9 @@ def motion(amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau):
     z = amp * sin_phase + ext_z + tau * (ext_v + 0.5 * ext_a * tau)
     v = amp * omega * cos_phase + ext_v + ext_a * tau
     return z, v
+
+
+@njit(inline="always")
+def acceleration(amp, omega, sin_phase, ext_a):
+    """Plate acceleration (the external input's held over the step)."""
+    return -amp * omega * omega * sin_phase + ext_a

@@ -24,6 +24,7 @@ variants it is used with only.
 from __future__ import annotations
 
 import importlib
+import math
 import pkgutil
 from dataclasses import dataclass, replace
 from types import ModuleType
@@ -126,6 +127,16 @@ def offered_by(models: str) -> list[str]:
 
 
 # ---------------------------------------------------------------- compiled dispatch
+@njit(inline="always")
+def frame(slope):
+    """cos a and sin a of the surface's tangent at a point of the given slope (a = arctan
+    slope); a flat plate skips the square root (model A's hot path)."""
+    if slope == 0.0:
+        return 1.0, 0.0
+    cos_a = 1.0 / math.sqrt(1.0 + slope * slope)
+    return cos_a, slope * cos_a
+
+
 def profile(kind, x, prm):
     """Surface height and slope of variant ``kind`` at x (compiled code only)."""
 

@@ -204,7 +204,7 @@ def test_energy_balance_closes_to_rounding(settings):
     for skip, bound in ((False, 1e-11), (True, 1e-10)):
         block = exact(energy_balance=True, **settings)
         n = int(round(3000.0 / block.parameters["dt"]))
-        assert event_driven.advance_exact(block.y, block.cnt, block.drv, block.prm, n, True,
+        assert event_driven.advance_exact(block.settings.kind, block.y, block.cnt, block.drv, block.prm, n, True,
                                           event_driven.EVENT_TOL, skip) == 0
         block.time = 3000.0
         block._observed = None
@@ -230,7 +230,7 @@ def test_skipping_periods_of_a_locked_bounce_matches_integrating_them():
         block = Block("A", "event_driven", energy_balance=True, **settings)
         block.start()
         n = int(2e5 / block.parameters["dt"])
-        assert event_driven.advance_exact(block.y, block.cnt, block.drv, block.prm, n, True,
+        assert event_driven.advance_exact(block.settings.kind, block.y, block.cnt, block.drv, block.prm, n, True,
                                           event_driven.EVENT_TOL, skip) == 0
         block.time = 2e5
         block._observed = None

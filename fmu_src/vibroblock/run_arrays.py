@@ -1,0 +1,51 @@
+"""The arrays of a run (``layout``): made at the start, retuned with the drive, saved and
+restored whole (the FMU state), handed to the kernels as they are."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import layout as L
+from .integrators.plate import reduced_phase
+from .settings import ModelError
+
+
+def fresh(parameters: dict, t0: float):
+    """(y, cnt, drv, prm) at the start time t0: the parameters in their slots, the clock
+    and the drive (its phase reduced exactly), the state and counters zero."""
+    prm = np.zeros(L.N_PRM)
+    for name, index in L.prm_slots().items():
+        prm[index] = parameters.get(name, 0.0)
+    drv = np.zeros(L.N_DRV)
+    drv[L.D_T0], drv[L.D_DT] = t0, parameters["dt"]
+    drv[L.D_AMP], drv[L.D_OMEGA] = parameters["A"], parameters["omega"]
+    drv[L.D_PHASE], drv[L.D_EXT_T] = reduced_phase(0.0, parameters["omega"], t0), t0
+    return np.zeros(L.N_Y), np.zeros(L.N_CNT, dtype=np.int64), drv, prm
+
+
+def retune_drive(cnt, drv, amplitude: float, omega: float) -> None:
+    """Take a new A, omega from the current grid step on, keeping the phase continuous:
+    the phase is re-anchored there."""
+    n = cnt[L.C_STEP]
+    step_rate = drv[L.D_OMEGA] * drv[L.D_DT]  # the kernels' phase per grid step
+    phase = reduced_phase(drv[L.D_PHASE], step_rate, n - cnt[L.C_PHASE_STEP])
+    drv[L.D_PHASE], cnt[L.C_PHASE_STEP] = phase, n
+    drv[L.D_AMP], drv[L.D_OMEGA] = amplitude, omega
+
+
+def saved(y, cnt, drv, prm) -> dict:
+    """The arrays as plain (JSON-able) values."""
+    return {"y": y.tolist(), "cnt": cnt.tolist(), "drv": drv.tolist(), "prm": prm.tolist()}
+
+
+def restored(state: dict):
+    """(y, cnt, drv, prm) from ``saved``'s values; ModelError if they are not a run's."""
+    try:
+        y = np.array(state["y"], dtype=float)
+        cnt = np.array(state["cnt"], dtype=np.int64)
+        drv = np.array(state["drv"], dtype=float)
+        prm = np.array(state["prm"], dtype=float)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ModelError(f"not a valid block state: {exc}") from None
+    if (y.shape, cnt.shape, drv.shape, prm.shape) != ((L.N_Y,), (L.N_CNT,), (L.N_DRV,), (L.N_PRM,)):
+        raise ModelError("not a valid block state: array sizes differ from this model's")
+    return y, cnt, drv, prm
