@@ -28,6 +28,10 @@ GRID_TOLERANCE = 1e-6
 STEP_BUDGET_PER_CALL = 2**36
 # An fmi2Integer is a C int: a count output is held at its largest value beyond it.
 FMI_INTEGER_MAX = 2**31 - 1
+# Attributes of a Block that are its settings' (``Settings``).
+FROM_SETTINGS = frozenset({"model", "parameters", "integrator", "initial_state", "energy_balance", "scene", "readings",
+                           "options", "set_integrator", "set_initial_state", "set_energy_balance", "set_reading",
+                           "set_scene_option", "set_integrator_option"})
 __all__ = ["Block", "ModelError", "OUTPUTS"]
 
 
@@ -53,14 +57,12 @@ class Block:
         self._link = NativeLink(GRID_TOLERANCE)
 
     # ------------------------------------------------------------------ settings
-    model = property(lambda self: self.settings.model)
-    parameters = property(lambda self: self.settings.parameters)
-    integrator = property(lambda self: self.settings.integrator)
-    initial_state = property(lambda self: self.settings.initial_state)
-    energy_balance = property(lambda self: self.settings.energy_balance)
-    scene = property(lambda self: self.settings.scene)
-    readings = property(lambda self: self.settings.readings)
-    options = property(lambda self: self.settings.options)
+    def __getattr__(self, name: str):
+        """What the run is (``model``, ``parameters``, ``integrator``, ``readings``, ...) and
+        the setters of what it will be, each value checked as it is set: the settings'."""
+        if name in FROM_SETTINGS:
+            return getattr(self.settings, name)
+        raise AttributeError(f"'Block' object has no attribute {name!r}")
 
     def set_parameter(self, name: str, value: float) -> None:
         """Set a parameter; during a run only A and omega, which retune the drive.  A
@@ -79,14 +81,6 @@ class Block:
             self._retune_drive()
             if self.settings.kernel(self.frozen_released) is not self._kernel:
                 self._bind_kernels()
-
-    # Settings chosen before a run, each checked as it is set (``Settings``).
-    set_integrator = property(lambda self: self.settings.set_integrator)
-    set_initial_state = property(lambda self: self.settings.set_initial_state)
-    set_energy_balance = property(lambda self: self.settings.set_energy_balance)
-    set_reading = property(lambda self: self.settings.set_reading)
-    set_scene_option = property(lambda self: self.settings.set_scene_option)
-    set_integrator_option = property(lambda self: self.settings.set_integrator_option)
 
     # ------------------------------------------------------------------ native front end
     _native = property(lambda self: self._link.record, doc="The NativeStep record (vibroblock.native).")

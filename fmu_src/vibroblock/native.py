@@ -168,77 +168,52 @@ class NativeLink:
         return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
-# One factory per advance kernel, each compiling a cfunc for one method (the kernels take
-# it as a literal; kind is an argument, so one cfunc serves every variant and reading).  The kernel is named in the body, not captured: numba
-# keys a cached cfunc by its closure's values, which must be plain numbers to be found
-# again by the next process.
-def _fixed_step_entry(method: int):
+# The kernel families with a C entry.  A cfunc names its kernel in the body (a global),
+# not captured: numba keys a cached cfunc by its closure's values, which must be plain
+# numbers to be found again by the next process.  So one factory per signature holds
+# the family and the method (the kernels take it as a literal; kind is an argument, so
+# one cfunc serves every variant, reading and law), and the branches of the families not
+# taken are pruned when the cfunc is compiled.
+FIXED_STEP, EVENT_DRIVEN, ADAPTIVE, SCENES = 0, 1, 2, 3
+
+
+def _advance_entry(family: int, method: int):
     @cfunc(SIGNATURE, cache=True)
-    def advance(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
-        return STATUS_SHIFT + fixed_step.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
-                                                 carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
-                                                 track_energy != 0)
+    def advance(kind, flags, y_ptr, cnt_ptr, drv_ptr, prm_ptr, n_steps, track_energy):
+        y, cnt = carray(y_ptr, L.N_Y), carray(cnt_ptr, L.N_CNT)
+        drv, prm, energy = carray(drv_ptr, L.N_DRV), carray(prm_ptr, L.N_PRM), track_energy != 0
+        if family == 0:  # FIXED_STEP
+            status = fixed_step.advance(kind, method, flags, y, cnt, drv, prm, n_steps, energy)
+        elif family == 1:  # EVENT_DRIVEN
+            status = event_driven.advance(kind, method, flags, y, cnt, drv, prm, n_steps, energy)
+        else:
+            status = adaptive.advance(kind, method, flags, y, cnt, drv, prm, n_steps, energy)
+        return STATUS_SHIFT + status
     return advance
 
 
-def _event_driven_entry(method: int):
-    @cfunc(SIGNATURE, cache=True)
-    def advance(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
-        return STATUS_SHIFT + event_driven.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
-                                                   carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
-                                                   track_energy != 0)
-    return advance
-
-
-def _adaptive_entry(method: int):
-    @cfunc(SIGNATURE, cache=True)
-    def advance(kind, flags, y, cnt, drv, prm, n_steps, track_energy):
-        return STATUS_SHIFT + adaptive.advance(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT),
-                                               carray(drv, L.N_DRV), carray(prm, L.N_PRM), n_steps,
-                                               track_energy != 0)
-    return advance
-
-
-def _fixed_step_observe(method: int):
+def _observe_entry(family: int, method: int):
     @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
-        fixed_step.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
-                           carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
+    def observe(kind, flags, y_ptr, cnt_ptr, drv_ptr, prm_ptr, h, track_energy, obs_ptr):
+        y, cnt, obs = carray(y_ptr, L.N_Y), carray(cnt_ptr, L.N_CNT), carray(obs_ptr, L.N_OBS)
+        drv, prm, energy = carray(drv_ptr, L.N_DRV), carray(prm_ptr, L.N_PRM), track_energy != 0
+        if family == 0:  # FIXED_STEP
+            fixed_step.observe(kind, method, flags, y, cnt, drv, prm, h, energy, obs)
+        elif family == 1:  # EVENT_DRIVEN
+            event_driven.observe(kind, method, flags, y, cnt, drv, prm, h, energy, obs)
+        elif family == 2:  # ADAPTIVE
+            adaptive.observe(kind, method, flags, y, cnt, drv, prm, h, energy, obs)
+        else:
+            scenes.observe(kind, method, flags, y, cnt, drv, prm, h, energy, obs)
         return OBSERVED_OK
     return observe
 
 
-def _event_driven_observe(method: int):
-    @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
-        event_driven.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
-                             carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
-        return OBSERVED_OK
-    return observe
-
-
-def _adaptive_observe(method: int):
-    @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
-        adaptive.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
-                         carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
-        return OBSERVED_OK
-    return observe
-
-
-def _scene_observe(method: int):
-    @cfunc(OBSERVE_SIGNATURE, cache=True)
-    def observe(kind, flags, y, cnt, drv, prm, h, track_energy, obs):
-        scenes.observe(kind, method, flags, carray(y, L.N_Y), carray(cnt, L.N_CNT), carray(drv, L.N_DRV),
-                       carray(prm, L.N_PRM), h, track_energy != 0, carray(obs, L.N_OBS))
-        return OBSERVED_OK
-    return observe
-
-
-_FACTORIES = {fixed_step.advance: _fixed_step_entry, event_driven.advance: _event_driven_entry,
-              adaptive.advance: _adaptive_entry, fixed_step.observe: _fixed_step_observe,
-              event_driven.observe: _event_driven_observe, adaptive.observe: _adaptive_observe,
-              scenes.observe: _scene_observe}
+# kernel -> (factory, family); the family numbers are the branches above
+_FACTORIES = {fixed_step.advance: (_advance_entry, FIXED_STEP), event_driven.advance: (_advance_entry, EVENT_DRIVEN),
+              adaptive.advance: (_advance_entry, ADAPTIVE), fixed_step.observe: (_observe_entry, FIXED_STEP),
+              event_driven.observe: (_observe_entry, EVENT_DRIVEN), adaptive.observe: (_observe_entry, ADAPTIVE),
+              scenes.observe: (_observe_entry, SCENES)}
 _ENTRIES: dict = {}  # (kernel, method) -> cfunc, kept alive with its code
 
 
@@ -247,9 +222,9 @@ def entry_address(kernel, method: int) -> int | None:
     or loaded from the cache once per process; None for a kernel without a C entry."""
     key = (kernel, method)
     if key not in _ENTRIES:
-        factory = _FACTORIES.get(kernel)
+        factory, family = _FACTORIES.get(kernel, (None, None))
         try:
-            _ENTRIES[key] = factory(method) if factory is not None else None
+            _ENTRIES[key] = factory(family, method) if factory is not None else None
         except Exception:  # noqa: BLE001 - no C entry is no error: every doStep goes through Python
             _ENTRIES[key] = None
     entry = _ENTRIES[key]

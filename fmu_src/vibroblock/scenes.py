@@ -39,8 +39,8 @@ from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
 from .dynamics import contact, friction_rule
-from .laws import contact_dissipation, contact_elastic, friction_released, friction_spring_force
-from .integrators.fixed_step import OK, STOP, record_observation
+from .laws import contact_dissipation, contact_elastic, friction_spring_force
+from .integrators.fixed_step import OK, STOP, book_energy, record_observation
 from .integrators.plate import drive_sin_cos, phase_after, plate_after, plate_at
 from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_M,
                      P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
@@ -226,10 +226,8 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             shear, reset = friction_rule(kind, shear, 1.0 if engaged else 0.0, end_normal, prm)
             slips += reset
         phi += d_phi
-        if track_energy:
-            work += d_work
-            dissipated += d_dissipated + friction_released(kind, loaded, shear, prm)
-            e_normal += d_normal
+        work, dissipated, e_normal = book_energy(kind, prm, (work, dissipated, e_normal),
+                                                 (d_work, d_dissipated, d_normal), loaded, shear, track_energy)
         t += h
         pz0, pv0 = pz1, pv1
     # The forces acting at the reported state: those of a step of dt starting there.

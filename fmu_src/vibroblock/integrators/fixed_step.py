@@ -56,20 +56,19 @@ def scheme_step(method):
     """The ``step`` of scheme ``method`` (compiled code only)."""
 
 
-@overload(scheme_prepare)
-def _scheme_prepare(method):
-    if isinstance(method, types.IntegerLiteral):
-        prepare = SCHEMES[method.literal_value][0]
-        return lambda method: prepare
-    return None
+def _scheme_part(index):
+    """Typing of ``scheme_prepare`` (index 0) or ``scheme_step`` (1): the registered
+    scheme's function for a literal method."""
+    def typer(method):
+        if isinstance(method, types.IntegerLiteral):
+            part = SCHEMES[method.literal_value][index]
+            return lambda method: part
+        return None
+    return typer
 
 
-@overload(scheme_step)
-def _scheme_step(method):
-    if isinstance(method, types.IntegerLiteral):
-        step = SCHEMES[method.literal_value][1]
-        return lambda method: step
-    return None
+overload(scheme_prepare)(_scheme_part(0))
+overload(scheme_step)(_scheme_part(1))
 
 
 @njit(inline="always")
@@ -98,17 +97,31 @@ def is_finite_state(x, z, vx, vz, shear):
 
 
 @njit(inline="always")
-def settle(kind, prm, shear, rule_penetration, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
-           d_phi, d_work, d_dissipated, d_normal, track_energy):
-    """End of every step of every scheme: the friction rule at the new state (a reset
-    releases k_t F^2/2, counted as dissipated), then the step's quadratures."""
-    loaded = shear
-    shear, reset = friction_rule(kind, shear, rule_penetration, rule_normal, prm)
-    phi, phi_c = kahan_add(phi, phi_c, d_phi)
+def book_energy(kind, prm, energies, increments, loaded, shear, track_energy):
+    """The energy balance's sums (work, dissipated, normal spring) after a step with these
+    increments; a reset of the spring from ``loaded`` to ``shear`` releases what the
+    friction law says, counted as dissipated."""
+    work, dissipated, e_normal = energies
     if track_energy:
+        d_work, d_dissipated, d_normal = increments
         work += d_work
         dissipated += d_dissipated + friction_released(kind, loaded, shear, prm)
         e_normal += d_normal
+    return work, dissipated, e_normal
+
+
+@njit(inline="always")
+def settle(kind, prm, shear, rule, slips, sums, increments, track_energy):
+    """End of every step of every scheme: the friction rule at the new state (``rule`` =
+    the penetration and the bound's N there), then the step's quadratures: ``sums`` =
+    (phi, its compensation, work, dissipated, normal spring energy), ``increments`` the
+    step's (phi, work, dissipated, normal spring)."""
+    phi, phi_c, work, dissipated, e_normal = sums
+    loaded = shear
+    shear, reset = friction_rule(kind, shear, rule[0], rule[1], prm)
+    phi, phi_c = kahan_add(phi, phi_c, increments[0])
+    work, dissipated, e_normal = book_energy(kind, prm, (work, dissipated, e_normal), increments[1:], loaded, shear,
+                                             track_energy)
     return shear, slips + reset, phi, phi_c, work, dissipated, e_normal
 
 
@@ -153,8 +166,8 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
         x, z, vx, vz, contact0 = x1, z1, vx1, vz1, contact1
         rule_normal = coulomb_bound(kind, rule_normal, x, t1, prm)  # the contact force, or the applied load
         shear, slips, phi, phi_c, work, dissipated, e_normal = settle(
-            kind, prm, shear1, rule_pen, rule_normal, slips, phi, phi_c, work, dissipated, e_normal,
-            d_phi, d_work, d_dissipated, d_normal, track_energy)
+            kind, prm, shear1, (rule_pen, rule_normal), slips, (phi, phi_c, work, dissipated, e_normal),
+            (d_phi, d_work, d_dissipated, d_normal), track_energy)
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         done += 1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
@@ -208,10 +221,8 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         shear, reset = friction_rule(kind, shear, rule_pen, rule_normal, prm)
         slips += reset
         phi += d_phi
-        if track_energy:
-            work += d_work
-            dissipated += d_dissipated + friction_released(kind, loaded, shear, prm)
-            e_normal += d_normal
+        work, dissipated, e_normal = book_energy(kind, prm, (work, dissipated, e_normal),
+                                                 (d_work, d_dissipated, d_normal), loaded, shear, track_energy)
         t += h
     pen, u_n, u_t, cos_a, sin_a, normal = state_contact
     return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,

@@ -40,6 +40,8 @@ from types import ModuleType
 from .. import jitcache  # noqa: F401  (before numba: the kernel cache's folder and locator)
 from numba import njit  # noqa: E402
 
+from ..models import branches  # noqa: E402
+
 
 @dataclass(frozen=True)
 class Axis:
@@ -127,12 +129,7 @@ def _dispatch(axis_name: str, function: str, arguments: str):
         lines.append(f"    return _{ids[0]}({arguments})")
     else:
         lines.append(f"    law = (kind >> {axis.shift}) & {(1 << axis.width) - 1}")
-        for i, k in enumerate(ids[:-1]):  # (one return: numba's inliner wants one)
-            lines.append(f"    {'if' if i == 0 else 'elif'} law == {k}:")
-            lines.append(f"        result = _{k}({arguments})")
-        lines.append("    else:")
-        lines.append(f"        result = _{ids[-1]}({arguments})")
-        lines.append("    return result")
+        lines += branches("law", ids, arguments)
     exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registry's ids only
     # Compiled on its own, small enough for LLVM to inline it where it is called.
     return njit(namespace["dispatch"])
