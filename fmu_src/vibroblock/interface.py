@@ -36,24 +36,27 @@ OUTPUTS = {
                           "friction resets since the start (with energy_balance)"),
     "energy_residual": ("Real", "m_0 delta_0^2/tau_0^2", "stored energy change - work + dissipated: zero for the "
                         "exact dynamics, the integration error otherwise (with energy_balance)"),
-    # The cost since the start of the integrators that are not fixed-step (0 for the
-    # fixed-step ones, whose steps are the grid's, (t - t0) / dt).  An fmi2Integer has 32
-    # bits: held at its largest value beyond it.
-    "accepted_steps": ("Integer", "", "internal steps the adaptive integrator accepted since the start (none "
-                       "where it takes exact flows, exact_flows on model A)"),
-    "rejected_steps": ("Integer", "", "internal steps the adaptive integrator rejected since the start (error "
-                       "test failed, or a step past the plate's cap retaken)"),
-    "located_events": ("Integer", "", "switches the adaptive or event_driven integrator located since the start "
-                       "(contact, detachment, Coulomb reset, zero of N)"),
-    "jacobian_evaluations": ("Integer", "", "Jacobians the adaptive integrator evaluated since the start "
-                             "(RODAS4's linearisations)"),
-    "periods_jumped": ("Integer", "", "plate periods crossed since the start by the adaptive integrator's "
-                       "stroboscopic jumps, or skipped by the exact flows (event_driven, adaptive on model A) once "
-                       "the motion is periodic"),
 }
+# The cost since the start of the integrators that are not fixed-step (0 for the
+# fixed-step ones, whose steps are the grid's, (t - t0) / dt), as Integer outputs: name ->
+# (``Block.counters``' key, description).  An fmi2Integer has 32 bits: held at its
+# largest value beyond it.
+COSTS = {
+    "accepted_steps": ("accepted", "internal steps the adaptive integrator accepted since the start (none where it "
+                       "takes exact flows, exact_flows on model A)"),
+    "rejected_steps": ("rejected", "internal steps the adaptive integrator rejected since the start (error test "
+                       "failed, or a step past the plate's cap retaken)"),
+    "located_events": ("events", "switches the adaptive or event_driven integrator located since the start "
+                       "(contact, detachment, Coulomb reset, zero of N)"),
+    "jacobian_evaluations": ("jacobians", "Jacobians the adaptive integrator evaluated since the start "
+                             "(RODAS4's linearisations)"),
+    "periods_jumped": ("periods_jumped", "plate periods crossed since the start by the adaptive integrator's "
+                       "stroboscopic jumps, or skipped by the exact flows (event_driven, adaptive on model A) "
+                       "once the motion is periodic"),
+}
+OUTPUTS.update({name: ("Integer", "", text) for name, (_, text) in COSTS.items()})
 # The outputs that count the integrator's work (``Block.counters``' keys).
-COST_OUTPUTS = {"accepted_steps": "accepted", "rejected_steps": "rejected", "located_events": "events",
-                "jacobian_evaluations": "jacobians", "periods_jumped": "periods_jumped"}
+COST_OUTPUTS = {name: key for name, (key, _) in COSTS.items()}
 INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
 ENERGY_BALANCE = "account work, dissipation and stored energy (outputs work_input, energy_dissipated, " \
     "energy_residual; about a third more time per step)"

@@ -75,13 +75,17 @@ def frozen_penetration(prm, omega, r_re, r_im, s, c, ext_a):
 
 
 @njit(inline="always")
-def scene_step(kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, frozen_pen1, frozen_un1,
-               track_energy):
-    """One reduced step of length h.  Returns (x, z, vx, vz, F, engaged, N, T, d_phi, d_work,
+def scene_step(kind, flags, prm, state, t, h, plate, frozen_end, track_energy):
+    """One reduced step of length h from ``state`` = (x, z, vx, vz, F), ``plate`` = (height,
+    velocity) at t and at t + h, ``frozen_end`` the frozen orbit's (penetration, u_n) at
+    t + h.  Returns (x, z, vx, vz, F, engaged, N, T, d_phi, d_work,
     d_dissipated, d_normal): the new state, whether the block is in contact at its end,
     the normal force and the Coulomb friction force of the step (for the friction rule
     and the outputs), and the increments of the quadratures."""
     m = prm[P_M]
+    x, z, vx, vz, shear = state
+    pz0, pv0, pz1, pv1 = plate
+    frozen_pen1, frozen_un1 = frozen_end
     rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
     pen, u_n, u_t, c, s, normal = contact(kind, x, z, vx, vz, pz0, pv0, prm)
     plate_accel = (pv1 - pv0) / h
@@ -174,11 +178,13 @@ def prepare(kind, flags, drv, prm, h):
 
 
 @njit(inline="always")
-def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
     """One reduced step (``scene_step``) under the driver's contract.  With FROZEN it
     returns STOP, the step not taken, where the frozen orbit would lose contact at the
     step's end: the caller hands over to the full model there."""
     pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    t, h, span = clock
+    x, z, vx, vz, shear = state
     rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0
     pen_f, un_f = 0.0, 0.0
     if frozen:
@@ -186,7 +192,7 @@ def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, 
         if pen_f <= 0.0:  # the guard: the block would detach here, hand over
             return STOP, x, z, vx, vz, shear, contact0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
-        kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, pen_f, un_f, track_energy)
+        kind, flags, prm, state, t, h, (pz0, pv0, pz1, pv1), (pen_f, un_f), track_energy)
     if coulomb:  # no spring: nothing to reset (the driver's rule sees no contact and keeps F = 0)
         return OK, x, z, vx, vz, shear, contact0, 0.0, 0.0, d_phi, d_work, d_dissipated, d_normal
     end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
@@ -217,7 +223,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase),
                                          drv[D_EXT_A])
         x, z, vx, vz, shear, engaged, normal, friction, d_phi, d_work, d_dissipated, d_normal = scene_step(
-            kind, flags, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, pv1, pen_f, un_f, track_energy)
+            kind, flags, prm, (x, z, vx, vz, shear), t, h, (pz0, pv0, pz1, pv1), (pen_f, un_f), track_energy)
         loaded = shear
         if coulomb:
             shear = 0.0
@@ -234,7 +240,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     pz2, pv2 = plate_after(drv, cnt, cnt[C_STEP], h + dt)
     phase = phase_after(drv, cnt, cnt[C_STEP], h + dt)
     pen_f, un_f = frozen_penetration(prm, drv[D_OMEGA], r_re, r_im, math.sin(phase), math.cos(phase), drv[D_EXT_A])
-    probe = scene_step(kind, flags, prm, x, z, vx, vz, shear, t, dt, pz0, pv0, pz2, pv2, pen_f, un_f, False)
+    probe = scene_step(kind, flags, prm, (x, z, vx, vz, shear), t, dt, (pz0, pv0, pz2, pv2), (pen_f, un_f), False)
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, pz0, pv0, prm)
     in_contact = pen > 0.0
     if rigid:

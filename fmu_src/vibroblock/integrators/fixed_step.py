@@ -6,8 +6,9 @@ smallest example):
 ``prepare(kind, flags, drv, prm, h) -> ctx``
     what the scheme computes once per call for steps of length h (a propagator table,
     scratch arrays, ...); any tuple.
-``step(kind, flags, ctx, prm, drv, x, z, vx, vz, F, contact0, t, h, span, plate, track_energy)``
-    one step of length h from the state at time t, whose contact quantities
+``step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy)``
+    one step of length h from ``state`` = (x, z, vx, vz, F) at time t, ``clock`` =
+    (t, h, span), whose contact quantities
     ``contact0`` (``dynamics.contact``: penetration, u_n, u_t, cos a, sin a, N) are
     known (in the tangent frame the slots hold (x, zeta, u, w), ``dynamics``).  ``span`` is the step as the difference of the grid times it joins (differs
     from h by rounding; a scheme uses one or the other, always the same).  ``plate`` is
@@ -157,7 +158,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
         else:
             pzh, pvh, pz1, pv1 = pz0, pv0, pz0, pv0
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
-         d_normal) = step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, dt, t1 - t,
+         d_normal) = step(kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), contact0, (t, dt, t1 - t),
                           (pz0, pv0, pzh, pvh, pz1, pv1, s, c), track_energy)
         if status != OK:
             if status < 0:
@@ -207,7 +208,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         s1, c1 = math.sin(phase1), math.cos(phase1)
         pz1, pv1 = plate_at(drv, s1, c1, t + h)
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
-         d_normal) = step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, state_contact, t, h, h,
+         d_normal) = step(kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), state_contact, (t, h, h),
                           (pz0, pv0, pzh, pvh, pz1, pv1, s1, c1), track_energy)
         if status == OK:
             x, z, vx, vz, shear = x1, z1, vx1, vz1, shear1

@@ -573,12 +573,13 @@ def prepare(kind, flags, drv, prm, h):
 
 
 @njit(inline="always")
-def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
     # The step is h exactly (the propagator table's); the grid times' difference would
     # carry the rounding of large t.
     pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    t, h, span = clock
     status, x, z, vx, vz, shear, d_phi, d_work, d_dissipated = implicit_contact_step(
-        kind, prm, (x, z, vx, vz, shear), t, h, (pz0, pv0, pz1, pv1), ctx, track_energy)
+        kind, prm, state, t, h, (pz0, pv0, pz1, pv1), ctx, track_energy)
     contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
     # (the normal spring's energy is booked as its potential at observation time: no increment)
     return (status, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, 0.0)

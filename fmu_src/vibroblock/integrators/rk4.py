@@ -35,9 +35,12 @@ def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
 
 
 @njit(inline="always")
-def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, pz1, pv1, track_energy):
-    """One classical RK4 step of length h; returns the new state and the increments of
-    phi, work, dissipation and normal-spring energy."""
+def rk4_step(kind, prm, state, t, h, plate, track_energy):
+    """One classical RK4 step of length h from ``state`` = (x, z, vx, vz, F), ``plate`` =
+    (height, velocity) at t, t + h/2 and t + h; returns the new state and the increments
+    of phi, work, dissipation and normal-spring energy."""
+    x, z, vx, vz, shear = state
+    pz0, pv0, pz_half, pv_half, pz1, pv1 = plate[:6]
     half = 0.5 * h
     rx1, rz1, ax1, az1, df1, p1, w1, d1, e1 = _rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0, track_energy)
     vx2, vz2 = vx + half * ax1, vz + half * az1
@@ -62,11 +65,12 @@ def rk4_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz_half, pv_half, p
 
 
 @njit(inline="always")
-def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
     # The step is the difference of the grid times it joins (span), so that its stages
     # sit at the times the plate was evaluated for.
-    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
-    x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(
-        kind, prm, x, z, vx, vz, shear, t, span, pz0, pv0, pzh, pvh, pz1, pv1, track_energy)
+    t, h, span = clock
+    x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(kind, prm, state, t, span, plate,
+                                                                          track_energy)
+    pz1, pv1 = plate[4], plate[5]
     contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
     return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)

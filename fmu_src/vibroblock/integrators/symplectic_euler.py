@@ -20,10 +20,14 @@ def prepare(kind, flags, drv, prm, h):
 
 
 @njit(inline="always")
-def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plate_v, pz1, pv1, track_energy):
-    """One semi-implicit Euler step of length h from a state whose contact quantities
-    ``contact_now`` are known; returns the new state, its contact quantities, and the
+def euler_step(kind, prm, state, t, h, contact_now, plate, track_energy):
+    """One semi-implicit Euler step of length h from ``state`` = (x, z, vx, vz, F), whose
+    contact quantities ``contact_now`` are known, ``plate`` = (its velocity at t, height
+    and velocity at t + h); returns the new state, its contact quantities, and the
     increments of phi, work, dissipation and normal-spring energy."""
+    x, z, vx, vz, shear = state
+    plate_v, pz1, pv1 = plate
+    h_over_m = h / prm[P_M]
     pen, u_n, u_t, cos_a, sin_a, normal = contact_now
     fx, fz = force(kind, x, t, pen > 0.0, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_work = d_dissipated = d_normal = 0.0
@@ -45,8 +49,9 @@ def euler_step(kind, prm, x, z, vx, vz, shear, t, h, h_over_m, contact_now, plat
 
 
 @njit(inline="always")
-def step(kind, flags, ctx, prm, drv, x, z, vx, vz, shear, contact0, t, h, span, plate, track_energy):
+def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
     pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    t, h, span = clock
     x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
-        kind, prm, x, z, vx, vz, shear, t, h, h / prm[P_M], contact0, pv0, pz1, pv1, track_energy)
+        kind, prm, state, t, h, contact0, (pv0, pz1, pv1), track_energy)
     return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)
