@@ -29,9 +29,12 @@ checks every registered one against the rules a test can check):
 4. Failure.  ``advance`` returns 0 (OK), 1 (STOP: a guard stopped it early, the steps
    taken are stored) or a negative status from ``statuses``; on a negative status the
    arrays are exactly as they were on entry (the last good state).
-5. Energy.  With ``track_energy`` the work done on the block, the energy dissipated and
-   the normal spring's energy are accumulated (``dynamics.energy_rates``) to the
-   scheme's own order, so that stored - start - work + dissipated measures its error.
+5. Energy.  With ``track_energy`` the work done on the block and the energy dissipated
+   are accumulated (``dynamics.energy_rates``) to the scheme's own order, so that
+   stored - start - work + dissipated measures its error; the stored energies are booked
+   as their potentials when observed (``observation.stored_energy``), so the normal
+   spring's accumulated energy (``Y_E_NORMAL``) is read by nothing and a kernel may leave
+   it as it is (``event_driven``, ``implicit_contact`` do).
 6. Costs.  Located events and rejected steps are counted in cnt[C_EVENTS] and
    cnt[C_REJECTED] by the integrators that locate or reject.
 """

@@ -295,7 +295,7 @@ def contact_release(a, w2, b, d0, v0, span):
 
 
 # ---------------------------------------------------------------------- one step
-@njit(cache=True)
+@njit(inline="always")
 def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel):
     """The soft forces at the midpoint, in the frame there (step 2 of the module doc), from
     ``start`` = (delta, u_n, u_t, cos, sin) at the step's start.  Returns (status, (cos,
@@ -325,7 +325,7 @@ def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel):
     return 0, (cos_m, sin_m, turn_rate, slope_end), (force_n, force_t, drive_start - drive, load_x, load_z)
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t):
     """On a turning frame: the normal force with the centripetal term, and the rate at which
     delta changes as the tangent line under the block turns (d delta/dt = -u_n - delta
@@ -350,7 +350,7 @@ def _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t)
     return force_n, -turning * pen_mid
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _contact_segment(prm, table, h, d, v, b, span, track_energy, plate):
     """A contact segment of the normal flow from delta = d, delta' = v under the constant
     forcing b, up to a release within ``span``: (tau, released, delta, delta', the plate's
@@ -382,7 +382,7 @@ def _contact_segment(prm, table, h, d, v, b, span, track_energy, plate):
     return tau, switch, 0.0 if switch else d1, v1, work, dissipated
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _normal_flow(prm, table, h, d, v, in_contact, forces, segments, track_energy):
     """Step 3: the normal direction's exact flow over the step from delta = d, delta' = v,
     the contact switches located; ``forces`` = (normal force, delta's turning rate, cos,
@@ -429,7 +429,7 @@ def _normal_flow(prm, table, h, d, v, in_contact, forces, segments, track_energy
     return 0, n_seg, d, v, work, dissipated
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _plate_impulse(prm, tau, u, u1, y1, change, b, w2, k_drive):
     """Impulse and first moment over a tangential segment of the contact's tangential force
     T = -k_t F - gamma_t u_t: T = m u' - m b + k_drive y, so both follow from the flow's
@@ -447,7 +447,7 @@ def _plate_impulse(prm, tau, u, u1, y1, change, b, w2, k_drive):
     return impulse, moment
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _tangential_flow(kind, prm, table, h, start, forces, segments, track_energy, totals):
     """Step 4: the tangential direction's exact flow over the normal flow's segments, from
     ``start`` = (F, u_t): F in contact (both springs pull, the drive's by the travel since

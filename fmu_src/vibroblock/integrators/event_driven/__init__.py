@@ -97,7 +97,7 @@ EVENT_TOL = 1e-12
 MAX_IMMEDIATE = 16
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _segment_length(u_ev, event, u_rem, immediate, tol):
     """The segment's length and end event; a grazing that keeps switching back and forth
     at one instant moves on by one tolerance.  Returns (u, event, zero-length segments in a row)."""

@@ -57,7 +57,7 @@ def _step_from(g, g1, poly, poly1, p2, level, curvature):
     return max(reach, first_positive_root(g, g1, -0.5 * curvature))
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _next_probe(u, step, u_hi, tol):
     """Where a search goes from u after a safe step: at least the resolution (the
     tolerance, or 8 ulp of u) on, and at most to u_hi; inf where the safe step itself
@@ -105,7 +105,7 @@ def first_zero(s, u_lo, u_hi, tol):
 
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _pair_state(a, b, u):
     """``signal_state`` of a and of b at u, and which of a - b (+1) and a + b (-1) is at or
     below zero there (0: neither)."""
@@ -158,7 +158,7 @@ def first_zero_pair(a, b, u_lo, u_hi, tol):
 
 
 # ---------------------------------------------------------------------------- the events
-@njit(cache=True)
+@njit(inline="always")
 def _cascade_end(kind, prm, sig, u_ev, u_rem, tol, drive):
     """After a reset while N falls: the zero of N if the rest of the cascade can no longer
     give a friction impulse above the tolerance (the cascade is then cut there), else inf;
@@ -179,7 +179,7 @@ def _cascade_end(kind, prm, sig, u_ev, u_rem, tol, drive):
     return INF
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _coulomb_reset(kind, prm, sig, u_hi, tol, shear, flow, y_const):
     """First time mu_s N - k_t F or mu_s N + k_t F reaches zero before u_hi (inf if none, nan
     if the search failed), and the event it is.  The bound is the contact force's
@@ -211,7 +211,7 @@ def _coulomb_reset(kind, prm, sig, u_hi, tol, shear, flow, y_const):
     return r, EV_RESET_PLUS if sign > 0.0 else EV_RESET_MINUS
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _n_rises(sig, u_hi, tol):
     """First time N rises to zero (the spring held at 0 re-arms), inf if not before u_hi."""
     normal_sig, neg_n = sig[R_N], sig[R_NEG_N]
@@ -223,7 +223,7 @@ def _n_rises(sig, u_hi, tol):
     return first_zero(neg_n, 0.0, u_hi, tol)
 
 
-@njit(cache=True)
+@njit(inline="always")
 def next_event(kind, prm, sig, regime, just_reset, u_detach, u_rem, tol, drive, flow, y_const):
     """The first event in contact within u_rem: (u, event, regime), u = nan if a search
     failed.  ``u_detach`` is the time to the detachment (inf: not in the window); it bounds
@@ -254,7 +254,7 @@ def next_event(kind, prm, sig, regime, just_reset, u_detach, u_rem, tol, drive, 
     return u_ev, event, regime
 
 
-@njit(cache=True)
+@njit(inline="always")
 def detachment(sig, n_ref, off, dt, u_rem, tol):
     """The detachment's absolute time (grid index, offset; offset inf: not before the
     window's end), or offset nan if the search failed.  The vertical motion ignores the

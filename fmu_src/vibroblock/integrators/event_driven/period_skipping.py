@@ -27,7 +27,7 @@ T_PHASE, T_YDOT, T_STRETCH, T_VX, T_TIME, T_PHI, T_WORK, T_DISS, T_SLIPS = range
 N_RECORD = 9
 
 
-@njit(cache=True)
+@njit(inline="always")
 def drive_stretch(prm, drv, n_ref, off, x):
     """The drive spring's far end minus x at t0 + n_ref dt + off."""
     v_d = prm[P_VD]
@@ -66,7 +66,7 @@ def touchdown_period(book, count, length):
     return 0
 
 
-@njit(cache=True)
+@njit(inline="always")
 def touchdown(book, count, s, slips, prm, drv, clock, window_end, plate_end, costs):
     """Record a touchdown (the ``count``-th, state ``s``, clock (n_ref, off)); if the motion
     has locked onto a period, add the whole periods left before ``window_end`` but one.

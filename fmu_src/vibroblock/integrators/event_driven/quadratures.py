@@ -223,7 +223,7 @@ def product_integral(a, b, u):
     return total
 
 
-@njit(cache=True)
+@njit(inline="always")
 def kahan(total, compensation, value):
     """Compensated sum: phi runs over up to 1e12 grid steps."""
     corrected = value - compensation
@@ -231,7 +231,7 @@ def kahan(total, compensation, value):
     return new_total, (new_total - total) - corrected
 
 
-@njit(cache=True)
+@njit(inline="always")
 def segment_quadratures(kind, s, sig, prm, drv, flow, end, segment, in_contact, track_energy):
     """Add one segment's increments to the quadratures in ``s`` (phi and, with the energy
     balance, the work and the dissipation), ``s`` still holding the segment's start.

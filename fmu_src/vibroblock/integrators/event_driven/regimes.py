@@ -29,7 +29,7 @@ FREE, ENGAGED, HELD, CASCADE = 0, 1, 2, 3
 EV_NONE, EV_CONTACT, EV_DETACH, EV_RESET_PLUS, EV_RESET_MINUS, EV_N_RISES, EV_N_ZERO = range(7)
 
 
-@njit(cache=True)
+@njit(inline="always")
 def contact_constants(prm, drv):
     """(lam_n, k_n/m) of the contact oscillator, the complex amplitude of its steady
     response to the harmonic drive per unit of y's, and y's static offset."""
@@ -38,7 +38,7 @@ def contact_constants(prm, drv):
     return -gam_n / (2.0 * m), k_n / m, response, -m * (prm[P_G] + drv[D_EXT_A]) / k_n
 
 
-@njit(cache=True)
+@njit(inline="always")
 def horizontal_flow(kind, regime, stretch, shear, vx, prm):
     """The horizontal oscillator of a regime from (stretch, F, vx): its stiffness k, the
     particular solution a + b u, (lam, k/m), and the mode xi's value, rate and second
@@ -61,7 +61,7 @@ def horizontal_flow(kind, regime, stretch, shear, vx, prm):
 
 
 
-@njit(cache=True)
+@njit(inline="always")
 def contact_flow(kind, sig, consts, y_s, ydot_s, e_th, om, prm):
     """The contact regime's vertical flow from y = z - Z_p and its rate at the start: the
     signals of delta, N and y' (rows R_DELTA, R_N, R_YDOT), and (h_y, yh0, yh1): y's
@@ -83,7 +83,7 @@ def contact_flow(kind, sig, consts, y_s, ydot_s, e_th, om, prm):
     return h_y, yh0, yh1
 
 
-@njit(cache=True)
+@njit(inline="always")
 def flight_flow(sig, z, vz, drv, prm, tau_e, e_th):
     """The flight regime's contact signal z - Z_p (row R_CONTACT): ballistic z against the
     plate (its external input's part as a polynomial, the harmonic drive's as a harmonic)."""
@@ -92,7 +92,7 @@ def flight_flow(sig, z, vz, drv, prm, tau_e, e_th):
     set_signal(sig[R_CONTACT], z - ext_z, vz - ext_v, -0.5 * (prm[P_G] + drv[D_EXT_A]), 1j * drv[D_AMP] * e_th, om)
 
 
-@njit(cache=True)
+@njit(inline="always")
 def segment_end(s, prm, drv, flow, vertical, consts, regime, in_contact, u, th, tau_e):
     """The state a time u into the segment: ((x, z, vx, vz, F), (xi, xi'), (theta, plate
     height and velocity)); ``s`` holds the start, ``flow`` the horizontal flow,
@@ -119,7 +119,7 @@ def segment_end(s, prm, drv, flow, vertical, consts, regime, in_contact, u, th, 
     return (x_new, z_new, b_lin + xi_rate, vz_new, shear_new), (xi, xi_rate), (th_end, plate_z, plate_v)
 
 
-@njit(cache=True)
+@njit(inline="always")
 def carry(n_ref, off, dt):
     """The clock (grid index, offset) with the offset's whole grid steps carried into the index."""
     whole = math.floor(off / dt)

@@ -21,7 +21,7 @@ from .regimes import ENGAGED, EV_CONTACT, EV_DETACH, EV_N_RISES, EV_N_ZERO, FREE
 TOUCHING = 1.0
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _contact_force_armed(kind, prm, penetration, u_n, plate_a):
     """The contact force N at a switch, and whether the spring is armed there (mu_s N > 0,
     or N = 0 and rising).  N's rate is the law's value at the rates (the law is linear):
@@ -32,14 +32,14 @@ def _contact_force_armed(kind, prm, penetration, u_n, plate_a):
     return normal, mu_s * normal > 0.0 or (mu_s > 0.0 and normal == 0.0 and normal_rate > 0.0)
 
 
-@njit(cache=True)
+@njit(inline="always")
 def _release(kind, s, prm):
     """A reset of the spring: the energy it stored counts as dissipated."""
     s[Y_DISSIPATED] += friction_energy(kind, s[Y_F], prm)
     s[Y_F] = 0.0
 
 
-@njit(cache=True)
+@njit(inline="always")
 def start_side(kind, s, slips, prm, drv, th, tau_e):
     """The side of each switch the stored state ``s`` is on, the friction rule applied to
     it: (in contact, regime, slips)."""
@@ -67,7 +67,7 @@ def start_side(kind, s, slips, prm, drv, th, tau_e):
     return True, ENGAGED if armed else HELD, slips
 
 
-@njit(cache=True)
+@njit(inline="always")
 def switch(kind, s, slips, prm, drv, event, plate_end):
     """The rule at an event, ``s`` the state there and ``plate_end`` (phase, plate height and
     velocity): (in contact, regime, just reset, slips)."""
