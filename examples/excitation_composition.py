@@ -70,11 +70,26 @@ def run_experiment(steps=None, horizon=None, out_dir=ROOT / "out", fmu_dir=ROOT 
     return rows
 
 
-if __name__ == "__main__":
+def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=float, nargs="+")
-    parser.add_argument("--horizon", type=float)
-    parser.add_argument("--fmu-dir", type=Path, default=ROOT / "build" / "fmus")
-    parser.add_argument("--out", type=Path, default=ROOT / "out")
-    args = parser.parse_args()
-    run_experiment(args.steps, args.horizon, args.out, args.fmu_dir)
+    parser.add_argument("--steps", type=float, nargs="+",
+                        help="communication steps to compare, in tau_0 (default 0.05 0.1 0.25 0.5 1 2 4)")
+    parser.add_argument("--horizon", type=float, help="run length of each composition, in tau_0 (default 12000)")
+    parser.add_argument("--fmu-dir", type=Path, default=ROOT / "build" / "fmus",
+                        help="folder holding BlockA.fmu and Excitation.fmu (default: build/fmus/ of this "
+                             "repository, built by 'make fmus')")
+    parser.add_argument("--out", type=Path, default=ROOT / "out",
+                        help="folder for communication_step.md and .png (default: out/)")
+    args = parser.parse_args(argv)
+    from harness.user_errors import require_fmu, run_main
+
+    def run():
+        for name in ("BlockA.fmu", "Excitation.fmu"):
+            require_fmu(Path(args.fmu_dir) / name, "--fmu-dir")
+        run_experiment(args.steps, args.horizon, args.out, args.fmu_dir)
+
+    return run_main("excitation_composition.py", run)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -92,11 +92,19 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     return result
 
 
-if __name__ == "__main__":
+def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu", type=Path, default=ROOT / "build" / "fmus" / "BlockA.fmu")
-    parser.add_argument("--out", type=Path, default=ROOT / "out")
+    parser.add_argument("--fmu", type=Path, default=ROOT / "build" / "fmus" / "BlockA.fmu",
+                        help="BlockA.fmu to run (default: build/fmus/BlockA.fmu of this repository, built by "
+                             "'make fmus')")
+    parser.add_argument("--out", type=Path, default=ROOT / "out",
+                        help="folder for triggering.png, .csv and .md (default: out/)")
     parser.add_argument("--quick", action="store_true", help="three phases and three amplitudes only")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     quick = {"phases": (0.3, 0.7, 0.9), "peak_accelerations": (0.001, 0.3, 0.9)} if args.quick else {}
-    run_experiment(args.fmu, args.out, **quick)
+    from harness.user_errors import require_fmu, run_main
+    return run_main("triggering.py", lambda: run_experiment(require_fmu(args.fmu), args.out, **quick) and 0)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,7 +1,7 @@
 """Observables of a run: pure functions of its trajectory Dataset.
 
 Every function takes a Dataset as :func:`harness.runs.run.simulate` returns it (variables
-``x``, ``vx``, optionally ``phi_integral``, ``contact``, ``slip_count`` over ``time``;
+``x``, ``vx``, optionally ``phi_integral``, ``contact``, ``coulomb_resets`` over ``time``;
 the drive velocity ``V_d`` and the other parameters as attributes) and a measuring
 window; :func:`observe` computes them all under one :class:`ObservableSettings`
 and returns an :class:`Observables` record that states its window, transient and
@@ -193,9 +193,12 @@ def contact_fraction(ds: xr.Dataset, win: Window) -> float:
 
 
 def coulomb_resets(ds: xr.Dataset, win: Window) -> int:
-    if "slip_count" not in ds:
+    """Coulomb resets in the window (-1: not recorded); ``slip_count`` is the FMUs' old
+    name of the same output."""
+    name = next((n for n in ("coulomb_resets", "slip_count") if n in ds), None)
+    if name is None:
         return -1
-    counts = ds["slip_count"].values
+    counts = ds[name].values
     return int(counts[win.last] - counts[win.first])
 
 

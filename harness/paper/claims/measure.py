@@ -58,7 +58,7 @@ def run_and_measure(item: dict, pool) -> dict:
     """One run: observables plus the extras named in ``item["extras"]`` (worker task)."""
     point: PointSettings = item["point"]
     extras = item.get("extras", ())
-    outputs = ("x", "vx", "phi_integral", "contact", "slip_count", "penetration")
+    outputs = ("x", "vx", "phi_integral", "contact", "coulomb_resets", "penetration")
     ds = simulate(point.run, pool, outputs=outputs)
     result = {"observables": observe(ds, point.observe).as_dict()}
     win = window(ds, point.observe.transient, point.observe.window)
