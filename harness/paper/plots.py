@@ -14,10 +14,11 @@ from typing import Callable, Mapping
 import numpy as np
 import xarray as xr
 
-from harness.runs.observables import FLYING, HOPPING, JAMMED, SLIDING, STICK_SLIP, STUCK
+from harness.runs.observables import FLYING, HOPPING, JAMMED, MICRO_SLIP, SLIDING, STICK_SLIP, STUCK
 
 REGIME_STYLE = {
     STICK_SLIP: {"marker": "s", "color": "tab:red", "label": "stick-slip"},
+    MICRO_SLIP: {"marker": "P", "color": "tab:pink", "label": "micro-slip (slides, short slips)"},
     SLIDING: {"marker": "o", "color": "tab:blue", "label": "sliding"},
     HOPPING: {"marker": "D", "color": "tab:orange", "label": "hopping (no rests, intermittent contact)"},
     STUCK: {"marker": "x", "color": "tab:gray", "label": "no slip in window"},

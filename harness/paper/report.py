@@ -119,7 +119,7 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
         lines += [f"- {k}: {v}" for k, v in header.items()] + [""]
     lines += ["Verdicts are computed from the measured numbers by the criteria stated in each claim's module (`harness/paper/claims/`) "
               f"(relative tolerance {FORMULA_TOLERANCE:.0%} for formulas, {UNCHANGED_TOLERANCE:.0%} for 'unchanged', "
-              "bracket tests on the sweep grids). 'Friction' means regime stick_slip, stuck or jammed (held in the "
+              "bracket tests on the sweep grids). 'Friction' means regime stick_slip, micro_slip, stuck or jammed (held in the "
               "window); 'sliding' means following the drive (phi at most the threshold, drift >= V_d/2); 'hopping' large phi "
               "without rests and with contact less than half the window; 'flying' no contact. The rules are in "
               "`harness/runs/observables.py`.", "",

@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from harness.runs.observables import PHI_STICK_SLIP
+
 from .measure import OBSERVE_B, OMEGA_X, SCALED, VALLEY, WAVELENGTH, b_point, observe_json, run_and_measure
 from .study import Claim, Runner, Study
 from .readings import READINGS
@@ -130,7 +132,7 @@ def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
         row_b = Row("C5b", measured_b, AGREES if ok else DISAGREES,
                     f"median distance {'<=' if ok else '>'} {ROOT_TOLERANCE:g} wavelengths")
     measured_c = f"k_t = 0: regime {free['regime']}, {free['slip_events']} slips of {fmt(free['slip_length'])}"
-    if free["regime"] == "stick_slip":
+    if free["regime"] in PHI_STICK_SLIP:
         row_c = Row("C5c", measured_c, AGREES, "stick-slip without tangential spring")
     elif free["regime"] == "stuck":
         row_c = Row("C5c", measured_c, NOT_REPRODUCED, "no slip in the window (stuck): window shorter than a stick")

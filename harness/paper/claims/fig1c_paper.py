@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from harness.runs.observables import PHI_STICK_SLIP
 from harness.runs.settings import ObservableSettings, PointSettings
 
 from .measure import friction_held, loss_amplitude, observe_json, onset_amplitude, run_and_measure
@@ -61,7 +62,7 @@ def study_fig1c_paper(runner: Runner) -> Study:
         rows.append({"A": a, "omega": w, "regime": o["regime"], "phi": o["phi"],
                      "contact_fraction": o["contact_fraction"], "rest_fraction": o["rest_fraction"],
                      "slips_in_window": sampled_slips(x[t >= transient])})
-    stick_slip = [row for row in rows if row["regime"] == "stick_slip"]
+    stick_slip = [row for row in rows if row["regime"] in PHI_STICK_SLIP]
     measured = {"points": rows, "cycle_time": period,
                 "fewest_slips_at_stick_slip": min((row["slips_in_window"] for row in stick_slip), default=None)}
     settings = {"model": "A", "parameters": "paper (FMU defaults)", "integrator": "event_driven",
