@@ -82,7 +82,7 @@ def test_counts_are_not_made_physical_by_declaring_units(tmp_path, subprocess_en
     refused = one_error_line(run(vibroblock("record", ULN_RECORD, "--fmu", fmu, "--quantity", "velocity",
                                             "--unit", "m/s", "--freqmin", "0.02"), subprocess_env),
                              "vibroblock record")
-    assert "are counts" in refused and "velocity in m/s" in refused
+    assert "instrument's output (counts or volts" in refused and "velocity in m/s" in refused
     assert "--inventory" in refused and "--sensitivity" in refused
 
 

@@ -452,15 +452,14 @@ def _select_trace(stream: obspy.Stream, where: str, trace_id: str | None) -> obs
 
 
 def _is_counts(tr: obspy.Trace) -> bool:
-    """Samples as a digitizer writes them: integers (MiniSEED's integer encodings, GSE2's
-    CM6, ...), or a SAC file whose header says its dependent variable is counts or
-    unknown with integral values."""
+    """Samples as an instrument writes them, not ground motion: integers (MiniSEED's
+    integer encodings, GSE2's CM6, ...), or a SAC file whose header says its dependent
+    variable is volts (idep = 50), or unknown (idep = 5) with integral values."""
     if tr.stats.get("integer_samples") or np.issubdtype(tr.data.dtype, np.integer):
         return True
     sac = getattr(tr.stats, "sac", None)
-    if sac is not None and sac.get("idep") in (5, 50) and np.all(np.mod(tr.data, 1.0) == 0.0):
-        return True  # idep: 5 = unknown, 50 = volts / counts
-    return False
+    idep = None if sac is None else sac.get("idep")
+    return idep == 50 or (idep == 5 and bool(np.all(np.mod(tr.data, 1.0) == 0.0)))
 
 
 def _from_stream(stream: obspy.Stream, where: str, q: Quantity | None, unit: str | None,
@@ -490,10 +489,11 @@ def _from_stream(stream: obspy.Stream, where: str, q: Quantity | None, unit: str
                                               f"{unit} ({q.value}, flat response)"), **common)
         if _is_counts(tr) and getattr(tr.stats, "response", None) is None:
             raise RecordError(
-                f"{where}: the samples of {tr.id} are counts (integers, as a digitizer records them), so "
-                f"declaring them {q.value} in {unit} would not make them physical; give the instrument response "
+                f"{where}: the samples of {tr.id} are the instrument's output (counts or volts, as its header or "
+                f"integer samples say), so declaring them {q.value} in {unit} would not make them physical; give "
+                "the instrument response "
                 "(inventory: StationXML, RESP or dataless SEED; --inventory on the command line) or the "
-                f"recording chain's sensitivity in counts per {unit} (--sensitivity)")
+                f"recording chain's sensitivity in counts (or volts) per {unit} (--sensitivity)")
         return Record(data=tr.data * si_factor(q, unit), quantity=q,
                       history=(read_note, f"{q.value} in {unit} as stated by the caller"),
                       **common)
