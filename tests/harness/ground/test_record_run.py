@@ -83,3 +83,31 @@ def test_a_sac_record_in_volts_needs_a_sensitivity_and_runs_with_one(quick_fmus,
     assert "counts divided by the stated sensitivity" not in done.stdout  # the history is not printed
     peak = next(line for line in done.stdout.splitlines() if "peak_plate_acceleration_g" in line)
     assert float(peak.split()[1]) == pytest.approx(0.3, rel=0.05)  # --peak-g is the plate's peak, after stretching
+
+
+def test_the_excitation_fmu_plays_a_miniseed_record_with_its_response_in_fmpy(quick_fmus, tmp_path, subprocess_env):
+    """record_file names obspy's MiniSEED (counts), record_inventory its StationXML: the FMU
+    processes it at initialization as harness.ground.records does (same acceleration)."""
+    from fmpy import simulate_fmu
+
+    from harness.ground.records import load_ground_motion
+
+    fmu = str(quick_fmus / "Excitation.fmu")
+    played = simulate_fmu(fmu, stop_time=4000.0, output_interval=1.0,
+                          start_values={"mode": 4, "record_file": str(ULN_RECORD),
+                                        "record_inventory": str(ULN_INVENTORY), "amplitude_scale": 1.0,
+                                        "time_scale": 1.0})
+    motion = load_ground_motion(str(ULN_RECORD), inventory=str(ULN_INVENTORY))
+    # Played in the record's own seconds and metres: the samples at whole seconds are its own.
+    index = np.round(played["time"] / motion.dt).astype(int)
+    np.testing.assert_allclose(played["plate_a"], motion.acceleration[index], rtol=0,
+                               atol=1e-9 * np.max(np.abs(motion.acceleration)))
+    # Counts without their response are refused at initialization, with the parameter to set.
+    script = ("import sys\nfrom fmpy import simulate_fmu\ntry:\n    simulate_fmu(sys.argv[1], stop_time=1.0, "
+              "start_values={'mode': 4, 'record_file': sys.argv[2]})\nexcept Exception as exc:\n"
+              "    print('raised:', exc)\n")
+    done = subprocess.run([sys.executable, "-c", script, fmu, str(ULN_RECORD)], capture_output=True, text=True,
+                          env=subprocess_env, timeout=300)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("[ERROR]")]
+    assert len(errors) == 1 and "holds counts without an instrument response" in errors[0]
+    assert "set record_inventory" in errors[0] and "raised:" in done.stdout
