@@ -172,8 +172,10 @@ Block FMUs: <code>plate_z = amplitude_scale * w(s) * f(s)</code> with signal tim
 acceleration integrated exactly, at rest outside the record.</li></ul>
 <h2>Parameters</h2>
 {_table(("name", "unit", "default", "meaning"), rows)}
-<p><code>record_file</code> (String): a <code>.npz</code> or two-column text record; empty for the
-bundled record.</p>
+<p><code>record_file</code> (String): a <code>.npz</code> or two-column text record, or a seismic record in
+any format obspy reads (MiniSEED, SAC, GSE2, ..., PEER <code>.AT2</code>), processed at initialization to
+consistent SI motion (response removed with <code>record_inventory</code>, a StationXML, RESP or dataless
+SEED file, for a record in counts); empty for the bundled record.</p>
 {PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
 </body></html>
 """
