@@ -38,6 +38,14 @@ def run_experiment(steps=None, horizon=None, out_dir=ROOT / "out", fmu_dir=ROOT 
               "sampled at the same step.")
     print(header)
     print(table)
+    print("What the columns mean: h = communication step [tau_0]; master = how the plate reaches the block "
+          "(internal: its own drive, the reference; input: fmpy's input table; ssp_fmpy / ssp_libcosim: the "
+          "Excitation FMU connected in an SSP file); max |z - z_int| = largest height difference from the "
+          "reference [delta_0]; first slip - int = onset of the first slip minus the reference's [tau_0]; mean slip "
+          "- int = mean slip length minus the reference's [delta_0] (slips counted from the motion); final x - int "
+          "[delta_0]; phi/phi_int - 1 = relative error of the order parameter; plate bounds = the plate's largest "
+          "height and velocity error per step from holding its acceleration, |j| h^3/6 [delta_0] and |j| h^2/2 "
+          "[delta_0/tau_0] with |j| = A omega^3.")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "communication_step.md").write_text(header + "\n\n" + table + "\n")

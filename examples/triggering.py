@@ -40,6 +40,14 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     table = result.to_markdown()
     print(header)
     print(table)
+    print("What the columns mean: phase = when the record's peak hits, as a share of the stick (0: just after a "
+          "slip, 1: at the next one); stress ratio = k_t F / (mu_s m g) then, how close the friction spring is to "
+          "breaking; peak a and down peak = the record's largest and most negative plate acceleration [g]; "
+          "predicted reset / lift-off = the peak that breaks the spring / lifts the block off at that phase [g]; "
+          "resets = Coulomb resets (breaks of the friction spring) while the record plays; jump = largest travel "
+          "beyond the unshaken run in that time [delta_0]; contact = share of the record's time in contact; clock "
+          "advance = how much earlier the next slip came than without the record [tau_0] (> 0: earlier), and as a "
+          "share of the stick T; slip = length of that slip [delta_0]; outcome = what the record did.")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     result.to_csv(out_dir / "triggering.csv")
