@@ -52,13 +52,14 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
 
     fig, ax = plt.subplots(figsize=(6.5, 4.0))
     t = np.linspace(0.0, HORIZON, 2)
-    # The drive first and underneath, thin and grey: the sliding block follows it closely
-    # (it lags by x_0 = (gamma_t V_d + mu_s m g / 2) / k_d), and must stay visible on top.
-    ax.plot(t, SCALED["V_d"] * t, color="0.55", ls="--", lw=0.8, zorder=1, label="drive $V_d t$")
+    # The sliding block follows the drive within a few delta_0: its curve is drawn wide and
+    # pale underneath, the drive thin, dashed and dark on top, so that both stay visible.
     colours = {"stick-slip": "tab:red", "sliding": "tab:blue"}
     for label, run in runs.items():
-        ax.plot(run["time"], run["x"], color=colours.get(label), lw=1.6 if label == "sliding" else 1.2, zorder=2,
-                label=f"{label}: $\\omega$ = {run['omega']:g} $\\tau_0^{{-1}}$, $\\phi$ = {run['phi']:.2g}")
+        wide = label == "sliding"
+        ax.plot(run["time"], run["x"], color=colours.get(label), lw=4.0 if wide else 1.2, alpha=0.45 if wide else 1.0,
+                zorder=1, label=f"{label}: $\\omega$ = {run['omega']:g} $\\tau_0^{{-1}}$, $\\phi$ = {run['phi']:.2g}")
+    ax.plot(t, SCALED["V_d"] * t, color="k", ls="--", lw=0.9, zorder=3, label="drive $V_d t$")
     ax.set_xlabel(r"time $t$ [$\tau_0$]")
     ax.set_ylabel(r"block position $x$ [$\delta_0$]")
     ax.set_title(f"Model A, A = {AMPLITUDE:g} $\\delta_0$ (scaled drive $k_d = V_d = 10^{{-2}}$)")

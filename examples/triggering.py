@@ -69,8 +69,8 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     p = np.linspace(0.0, 1.0, 2)
     left.plot(p, 1.0 - p, "k:", lw=0.8, label="slip at the peak: 1 − phase")
     left.axhline(0.0, color="k", lw=0.5)
-    left.set_xlabel("phase of the stick when the record peaks")
-    left.set_ylabel("clock advance / stick time")
+    left.set_xlabel("phase of the stick when the record peaks [1]")
+    left.set_ylabel("clock advance / stick time [1]")
     left.legend(fontsize=7, title="peak |a|", title_fontsize=7)
     left.set_title("slip brought forward (> 0) or delayed (< 0)")
 
@@ -84,7 +84,7 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     right.plot(phases_sorted, liftoff, "k--", lw=1, label="predicted lift-off")
     for outcome, (marker, color) in MARKERS.items():
         right.plot([], [], marker=marker, color=color, ls="none", label=outcome)
-    right.set_xlabel("phase of the stick when the record peaks")
+    right.set_xlabel("phase of the stick when the record peaks [1]")
     right.set_ylabel("peak plate acceleration [g]")
     right.set_yscale("log")
     right.legend(fontsize=7)

@@ -186,7 +186,7 @@ def draw_fig4(study: Study, save) -> None:
         ax.plot(stable, np.cos(omega_x * np.asarray(stable)), "o", color=color, ms=6)
         ax.plot(unstable, np.cos(omega_x * np.asarray(unstable)), "o", color=color, mfc="none", ms=6)
         ax.axvline(x, color=color, lw=2, alpha=0.5)
-    ax.set(xlabel="x", ylabel="", title="Eq. (9), model B, $k_t$ = 0 (scaled drive): roots filled = stable, "
+    ax.set(xlabel=r"$x$ [$\delta_0$]", ylabel="", title="Eq. (9), model B, $k_t$ = 0 (scaled drive): roots filled = stable, "
            "open = unstable;\nvertical bars: the simulated block at the first and last stuck sample and at the end")
     ax.title.set_fontsize("small")
     ax.legend(fontsize="x-small", loc="lower left")

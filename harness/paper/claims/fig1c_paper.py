@@ -109,7 +109,7 @@ def draw(study: Study, save) -> None:
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$",
                 loss=loss_amplitude)
-    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A",
+    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$ [$\tau_0^{-1}$]", ylabel=r"$A$ [$\delta_0$]",
            title=f"Model A, the paper's parameters (>= {study.settings['cycles']} stick-slip cycles per point)")
     ax.title.set_fontsize(9)
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
