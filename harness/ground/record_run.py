@@ -137,7 +137,7 @@ def run_record(settings: RecordRun, show_plot: bool = False) -> dict:
     print(f"record: {motion.source} ({motion.trace_id or 'one channel'}), {motion.time.size} samples at "
           f"{1 / motion.dt:g} Hz, {record_seconds:.4g} s after processing")
     print(f"block:  {settings.mass:g} kg on {settings.stiffness:g} N/m, so delta_0 = {scales.length_scale:.4g} m and "
-          f"tau_0 = {scales.time_scale:.4g} s; the record plays {settings.time_stretch:g}x slower")
+          f"tau_0 = {scales.time_scale:.4g} s; the record is played {_pace(settings.time_stretch)}")
     print(f"run:    model {settings.model.upper()}, integrator {settings.integrator}, {stop:g} tau_0 "
           f"(= {stop / time_scale:.4g} s of the record), communication step {step:g} tau_0")
     for note in notes:
@@ -164,6 +164,12 @@ def _integrator_code(fmu: Path, name: str) -> int:
     return choices[name]
 
 
+def _pace(stretch: float) -> str:
+    if stretch == 1.0:
+        return "at its own pace"
+    return f"{stretch:g}x slower" if stretch > 1.0 else f"{1.0 / stretch:g}x faster"
+
+
 def _drive_advance(values: dict, stop: float) -> float:
     return float(values.get("V_d", math.nan)) * stop
 
@@ -179,11 +185,12 @@ def _plot(settings, motion, scales, table, result, start_values, time_scale, sho
     axes[0].plot(t, table["plate_a"], lw=0.6, color="tab:gray")
     axes[0].set_ylabel("plate acceleration [g]")
     name = motion.trace_id or Path(str(settings.record_file)).name
-    axes[0].set_title(f"{name}: peak {float(np.max(np.abs(table['plate_a']))):.3g} g; "
-                      f"$\\delta_0$ = {scales.length_scale:.3g} m, $\\tau_0$ = {scales.time_scale:.3g} s")
+    # The title above the figure: the record's seconds run along the top of the first panel.
+    fig.suptitle(f"{name}: peak {float(np.max(np.abs(table['plate_a']))):.3g} g; "
+                 f"$\\delta_0$ = {scales.length_scale:.3g} m, $\\tau_0$ = {scales.time_scale:.3g} s", fontsize=10)
     # The record's own seconds on top, beside model time: s = t / time_scale.
     top = axes[0].secondary_xaxis("top", functions=(lambda x: x / time_scale, lambda s: s * time_scale))
-    top.set_xlabel(f"time in the record [s] (played {settings.time_stretch:g}x slower)")
+    top.set_xlabel(f"time in the record [s] (played {_pace(settings.time_stretch)})")
     axes[1].plot(result["time"], result["normal_force"], lw=0.6, color="tab:purple")
     axes[1].axhline(0.0, color="k", lw=0.5)
     axes[1].set_ylabel("normal force [m g]")
@@ -197,7 +204,7 @@ def _plot(settings, motion, scales, table, result, start_values, time_scale, sho
     axes[3].plot(result["time"], result["vx"], lw=0.6, color="tab:blue")
     axes[3].set_ylabel(r"$v_x$ [$\delta_0/\tau_0$]")
     axes[3].set_xlabel(r"model time [$\tau_0$]")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.97))
     out_dir = Path(settings.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     figure = out_dir / "record_response.png"
