@@ -51,7 +51,10 @@ class StudySettings:
 
     block_fmu: str = field(default_factory=lambda: default_fmu("A"))
     excitation_fmu: str = field(default_factory=lambda: str(Path(default_fmu("A")).with_name("Excitation.fmu")))
-    parameters: dict = field(default_factory=lambda: dict(PRESETS["scaled"]))
+    # The paper's fixed-step scheme, chosen explicitly (the FMUs default to adaptive): the
+    # tables in docs/excitation.md were measured with it, and its grid t0 + n dt does not
+    # change with the communication step, so what differs between runs is the plate input.
+    parameters: dict = field(default_factory=lambda: {**PRESETS["scaled"], "integrator": 0})
     amplitude: float = 0.4
     omega: float = 0.5
     horizon: float = 12_000.0

@@ -62,7 +62,10 @@ class TriggeringSettings:
     """Everything the experiment depends on (reported with the results)."""
 
     block_fmu: str = field(default_factory=lambda: default_fmu("A"))
-    parameters: dict = field(default_factory=lambda: dict(PRESETS["scaled"]))
+    # The paper's fixed-step scheme, chosen explicitly (the FMUs default to adaptive): the
+    # tables in docs/excitation.md were measured with it, and its grid t0 + n dt does not
+    # change with the communication step, so what differs between runs is the plate input.
+    parameters: dict = field(default_factory=lambda: {**PRESETS["scaled"], "integrator": 0})
     record_window: tuple[float, float] = (3.5, 11.5)  # seconds of obspy's example record
     pad_seconds: float = 1.0
     time_scale: float = 200.0  # model time units per record second
