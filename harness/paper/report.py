@@ -130,8 +130,8 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
     summary = {}
     for row in rows:
         figures = " ".join(f"[{f}]({f})" for f in row.figures if f in figures_present)
-        lines.append(f"| [{row.claim}](#{_anchor(row.claim)}) | {_cell(_short(CLAIM_TEXT[row.claim]))} | "
-                     f"{_cell(_short(row.measured))} | **{row.verdict}** | {figures} |")
+        lines.append(f"| {row.claim} | {_cell(_short(CLAIM_TEXT[row.claim]))} | "
+                     f"{_cell(_short(row.measured))} [details](#{_anchor(row.claim)}) | **{row.verdict}** | {figures} |")
         summary[row.verdict] = summary.get(row.verdict, 0) + 1
     lines += ["", "Summary: " + ", ".join(f"{v}: {n}" for v, n in sorted(summary.items()))]
     if reading_rows(studies):

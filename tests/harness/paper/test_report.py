@@ -108,5 +108,6 @@ def test_the_table_keeps_the_deciding_numbers_and_each_claim_has_its_section():
     assert sections.count(long_measured) == 1
     assert f"*Measured:* the same runs and numbers as {parts[0]} (above)." in sections
     assert "*Why disagrees:* 3 of 9 columns" in sections and "(Figure 1)" in sections
+    assert sections.count(f'<a id="{report._anchor(parts[0])}"></a>') == 1
     caption = report.figure_caption("fig1c.png", rows)
     assert caption.startswith(f"evidence for {parts[0]}, {parts[1]} -- ") and "delta_0" in caption
