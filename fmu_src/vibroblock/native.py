@@ -100,11 +100,12 @@ class NativeStep(ctypes.Structure):
 
 # The outputs that are plain entries of the observation in every reading: a native front
 # end may read them without Python (``Block._observables`` is the reference).  The Boolean
-# contact and the Integer slip_count are stored as 0.0/1.0 and a whole count; the front end
-# converts them as _observables does (!= 0, truncation).
+# contact and the Integer coulomb_resets (and its old name slip_count) are stored as 0.0/1.0
+# and a whole count; the front end converts them as _observables does (!= 0, truncation).
 OBSERVED_OUTPUTS = {"x": L.O_X, "friction_force": L.O_FRICTION, "normal_force": L.O_NORMAL,
                     "phi_integral": L.O_PHI, "penetration": L.O_PENETRATION, "work_input": L.O_WORK,
-                    "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "slip_count": L.O_SLIPS}
+                    "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "coulomb_resets": L.O_SLIPS,
+                    "slip_count": L.O_SLIPS}
 # ... and in the model's own reading, where the state is the point itself.
 OBSERVED_POINT = {"z": L.O_Z, "vx": L.O_VX, "vz": L.O_VZ, "surface_z": SURFACE_Z}
 

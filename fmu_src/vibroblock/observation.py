@@ -66,7 +66,8 @@ def observables(settings, prm, obs, stored_at_start: float) -> dict:
         "friction_force": float(obs[L.O_FRICTION]),
         "normal_force": float(obs[L.O_NORMAL]),
         "contact": bool(obs[L.O_CONTACT] != 0.0),
-        "slip_count": int(obs[L.O_SLIPS]),
+        "coulomb_resets": int(obs[L.O_SLIPS]),
+        "slip_count": int(obs[L.O_SLIPS]),  # the old name of coulomb_resets (interface.OUTPUT_ALIASES)
         "phi_integral": float(obs[L.O_PHI]),
         "penetration": float(pen),
         "surface_z": float(surface_z),

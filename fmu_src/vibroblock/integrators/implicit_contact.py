@@ -318,19 +318,17 @@ def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel):
     load_x, load_z = load(kind, cos_m, sin_m, prm)
     force_n = -(drive + load_x) * sin_m + load_z * cos_m - m * plate_accel * cos_m
     force_t = (drive + load_x) * cos_m + load_z * sin_m - m * plate_accel * sin_m
-    if pen0 > 0.0 and sin_m != 0.0:  # a conservative contact's curvature term, held over the step like the load
-        curving = curvature_force(kind, x_mid, pen0, cos_m, sin_m, prm)
-        force_n -= curving * sin_m
-        force_t += curving * cos_m
     return 0, (cos_m, sin_m, turn_rate, slope_end), (force_n, force_t, drive_start - drive, load_x, load_z)
 
 
 @njit(inline="always")
-def _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t):
-    """On a turning frame: the normal force with the centripetal term, and the rate at which
-    delta changes as the tangent line under the block turns (d delta/dt = -u_n - delta
-    tan(alpha) Omega), from half-step flows in the starting contact state (the O(h^2)
-    accuracy the midpoint rule needs), with the turning terms."""
+def _turning(kind, prm, table, h, shear, start, in_contact, frame_m, x_mid, force_n, force_t):
+    """On a turning frame: the forces with the centripetal term and, in contact, a
+    conservative contact's curvature term at the midpoint like the other soft forces; and
+    the rate at which delta changes as the tangent line under the block turns (d delta/dt
+    = -u_n - delta tan(alpha) Omega), from half-step flows in the starting contact state
+    (the O(h^2) accuracy the midpoint rule needs), with the turning terms.  Returns
+    (normal force, tangential force, delta's rate)."""
     m = prm[P_M]
     pen0, u_n0, u_t0, _, _ = start
     cos_m, sin_m, turn_rate, _ = frame_m
@@ -347,7 +345,11 @@ def _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t)
         pen_mid = _apply(_row(table, HALF + NORMAL_CONTACT), prm[P_KN] / m, pen0, pen_rate0, b_mid)[0]
     else:
         pen_mid = pen0 + 0.5 * h * pen_rate0 - 0.125 * h * h * force_n / m
-    return force_n, -turning * pen_mid
+    if in_contact:
+        curving = curvature_force(kind, x_mid, pen_mid, cos_m, sin_m, prm)
+        force_n -= curving * sin_m
+        force_t += curving * cos_m
+    return force_n, force_t, -turning * pen_mid
 
 
 @njit(inline="always")
@@ -522,7 +524,8 @@ def implicit_contact_step(kind, prm, state, t, h, plate, ctx, track_energy):
     delta_rate = 0.0
     in_contact = pen0 > 0.0 or (pen0 == 0.0 and u_n0 < 0.0)
     if turn_rate != 0.0:
-        force_n, delta_rate = _turning(prm, table, h, shear, start, in_contact, frame_m, force_n, force_t)
+        force_n, force_t, delta_rate = _turning(kind, prm, table, h, shear, start, in_contact, frame_m,
+                                                x + 0.5 * h * vx, force_n, force_t)
 
     status, n_seg, pen1, v, work, dissipated = _normal_flow(
         prm, table, h, pen0, delta_rate - u_n0, in_contact, (force_n, delta_rate, cos_m, pv0, plate_accel),
