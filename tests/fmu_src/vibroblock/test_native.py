@@ -108,10 +108,10 @@ def test_the_records_observation_gives_the_outputs(model, integrator, options, e
     block, record = driven(model, integrator, options, energy, REFS)
     block.start()
     own_reading = "formulation" not in options
-    served = {name for name in [*REAL_OUTPUTS, "contact", "slip_count"]
+    served = {name for name in [*REAL_OUTPUTS, "contact", "coulomb_resets", "slip_count"]
               if (own_reading or name not in ("z", "vx", "vz", "surface_z"))
               and not (energy and name == "energy_residual")}
-    convert = {"contact": lambda v: v != 0.0, "slip_count": int}
+    convert = {"contact": lambda v: v != 0.0, "coulomb_resets": int, "slip_count": int}
     normal_forces = []
     for t_end in (0.5, 0.7301, 2.0, 7.3105, 12.5):  # dt = 4e-4 (the default): two ends between grid points
         block.advance_to(t_end)

@@ -15,6 +15,7 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...dynamics import plate_motion
+from ..fixed_step import kahan_add
 from ...laws import contact_dissipation
 from ...layout import (D_AMP, D_EXT_A, D_EXT_V, D_EXT_Z, D_OMEGA, P_G, P_GT, P_KD, P_M, P_VD, Y_DISSIPATED, Y_PHI,
                        Y_PHI_C, Y_WORK, Y_X, Y_Z)
@@ -224,14 +225,6 @@ def product_integral(a, b, u):
 
 
 @njit(inline="always")
-def kahan(total, compensation, value):
-    """Compensated sum: phi runs over up to 1e12 grid steps."""
-    corrected = value - compensation
-    new_total = total + corrected
-    return new_total, (new_total - total) - corrected
-
-
-@njit(inline="always")
 def segment_quadratures(kind, s, sig, prm, drv, flow, end, segment, in_contact, track_energy):
     """Add one segment's increments to the quadratures in ``s`` (phi and, with the energy
     balance, the work and the dissipation), ``s`` still holding the segment's start.
@@ -246,7 +239,7 @@ def segment_quadratures(kind, s, sig, prm, drv, flow, end, segment, in_contact, 
     drift = b_lin - v_d
     phi_part = (drift * drift * u + 2.0 * drift * (xi - xi0)
                 + mode_square_integral(xi1, xi2, lam_t, kap_t, u, sig[R_SCRATCH]))
-    s[Y_PHI], s[Y_PHI_C] = kahan(s[Y_PHI], s[Y_PHI_C], phi_part)
+    s[Y_PHI], s[Y_PHI_C] = kahan_add(s[Y_PHI], s[Y_PHI_C], phi_part)  # phi runs over up to 1e12 grid steps
     if not track_energy:
         return
     vx_square = phi_part + 2.0 * v_d * (x_new - s[Y_X]) - v_d * v_d * u
