@@ -246,7 +246,7 @@ def _try_jump(run, v, acc, ic, tm, clk, ws):
     return OK
 
 
-@njit
+@njit(inline="always")
 def _attempt(run, v, ic, tm, clk, ws):
     """The step from (u, v): its rate (and Jacobian) where not current, its length (past
     the cap in a flight above the plate's reach; after a stagnant run of RODAS4 steps a
@@ -298,7 +298,7 @@ def _reject(ic, tm, err):
     return OK
 
 
-@njit
+@njit(inline="always")
 def _met_reach(run, v, ic, tm, ws):
     """A step past the cap (only in a flight above the plate's reach) must stay there at its
     samples and its end, else it is retaken at the cap (and the flight keeps the cap until
@@ -390,7 +390,7 @@ def _step_on(ic, tm, trial, v, acc):
     tm[T_H] = min(tm[T_H_WANT], tm[T_CAP])
 
 
-@njit
+@njit(inline="always")
 def _events(run, v, acc, ic, tm, clk, ws):
     """The accepted step's events: none (commit it), a graze seen on the interpolant only
     (commit it), or a switch located on full steps (restart there, in the regime after it).

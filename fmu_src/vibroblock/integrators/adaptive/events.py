@@ -96,7 +96,7 @@ def _interpolant_root(taken, e, previous, s, g_s):
     return regula_falsi(search, previous, g_a, s, g_s, taken[5], EVENT_TOL, best, best)
 
 
-@njit
+@njit(inline="always")
 def first_event(taken):
     """The first sub-interval of the step's interpolant in which an event value changes
     sign: (the event, its root on the interpolant, the sample that showed it), or EV_NONE."""

@@ -18,7 +18,7 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...layout import D_AMP, D_OMEGA, P_ATOL, P_RTOL
-from .regimes import NS, NV, rates
+from .regimes import NS, NV, plate, rates, rhs
 from .workspace import F0, FT, K, RATE, SCRATCH, STAGE
 
 # Hairer & Wanner, Sec. IV.7, Table 7.3: the transformed stages
@@ -110,21 +110,22 @@ def linearise(system, clk, v, t_abs, u, ws):
     """f at the step's start (ws F0), its Jacobian on the state block (central
     differences) and its explicit time derivative (ws FT: a difference quotient over an
     exactly representable increment)."""
+    kind, regime, drv, prm, track_energy = system
     rows, jac = ws[0], ws[1]
-    drv = system[2]
     f0, ft = rows[F0], rows[FT]
     probe, plus, minus = rows[SCRATCH], rows[SCRATCH + 1], rows[SCRATCH + 2]
-    rates(system, clk, v, t_abs, u, f0)
+    pz, pv = plate(drv, clk, u)  # once: every column is taken at the same time
+    rhs(kind, regime, v, t_abs, pz, pv, prm, track_energy, f0)
     for i in range(NV):
         probe[i] = v[i]
     for j in range(NS):
         step = JAC_STEP * max(1.0, abs(v[j]))
         probe[j] = v[j] + step
         up = probe[j] - v[j]
-        rates(system, clk, probe, t_abs, u, plus)
+        rhs(kind, regime, probe, t_abs, pz, pv, prm, track_energy, plus)
         probe[j] = v[j] - step
         down = v[j] - probe[j]
-        rates(system, clk, probe, t_abs, u, minus)
+        rhs(kind, regime, probe, t_abs, pz, pv, prm, track_energy, minus)
         probe[j] = v[j]
         inv = 1.0 / (up + down)
         for i in range(NV):
