@@ -73,21 +73,20 @@ def explicit_step(system, clk, v, t_abs, u, h, ws, out):
 def stiffness(h, ws, out):
     """h rho with rho ~ |f(y1) - f(y12)| / |y1 - y12| over the state (DOP853's test)."""
     rows = ws[0]
-    stage, kx = rows[STAGE], rows[KX:KX + EXPLICIT_STAGES + 1]
     num = den = 0.0
     for i in range(NS):
-        num += (kx[EXPLICIT_STAGES, i] - kx[EXPLICIT_STAGES - 1, i]) ** 2
-        den += (out[i] - stage[i]) ** 2
+        num += (rows[KX + EXPLICIT_STAGES, i] - rows[KX + EXPLICIT_STAGES - 1, i]) ** 2
+        den += (out[i] - rows[STAGE, i]) ** 2
     return h * math.sqrt(num / den) if den > 0.0 else 0.0
 
 
 @njit(inline="always")
 def hermite(v, out, ws, h, s, res):
     """The cubic Hermite interpolant of the step's end values and rates at fraction s."""
-    kx = ws[0][KX:KX + EXPLICIT_STAGES + 1]
+    rows = ws[0]  # indexed in place: a view per call costs reference counting in the event loop
     s2 = s * s
     s3 = s2 * s
     a0, a1 = 2.0 * s3 - 3.0 * s2 + 1.0, -2.0 * s3 + 3.0 * s2
     b0, b1 = h * (s3 - 2.0 * s2 + s), h * (s3 - s2)
     for i in range(NS):
-        res[i] = a0 * v[i] + a1 * out[i] + b0 * kx[0, i] + b1 * kx[EXPLICIT_STAGES, i]
+        res[i] = a0 * v[i] + a1 * out[i] + b0 * rows[KX, i] + b1 * rows[KX + EXPLICIT_STAGES, i]

@@ -303,10 +303,10 @@ def _met_reach(run, v, ic, tm, ws):
     """A step past the cap (only in a flight above the plate's reach) must stay there at its
     samples and its end, else it is retaken at the cap (and the flight keeps the cap until
     its landing).  True if it is to be retaken."""
-    kind, drv, prm, track_energy = run
     h, cap = tm[T_H], tm[T_CAP]
     if not h > cap:
         return False
+    kind, drv, prm, track_energy = run
     explicit = ic[I_EXPLICIT] != 0
     probe, trial = ws[0][PROBE], ws[0][TRIAL]
     for sample in range(1, EVENT_SAMPLES + 1):
@@ -405,7 +405,7 @@ def _events(run, v, acc, ic, tm, clk, ws):
         ic[I_FRESH] = explicit  # the explicit pair's last rate is the next step's first
         if explicit:
             for i in range(NV):
-                rows[F0][i] = rows[KX + EXPLICIT_STAGES][i]
+                rows[F0, i] = rows[KX + EXPLICIT_STAGES, i]
         ic[I_IMMEDIATE] = 0
         return OK
     hi = locate_switch(taken, event, s_hi, s_sample)

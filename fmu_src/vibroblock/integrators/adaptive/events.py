@@ -18,7 +18,7 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from .methods import EVENT_SAMPLES, interpolate, sample_state, step
-from .regimes import EV_NONE, NV, event_at, events_of, plate, value, value_at
+from .regimes import EV_NONE, NV, event_at, event_value, events_of, plate, switch_values, value_at
 from .rodas4 import EPS
 from .workspace import BEST, PROBE
 
@@ -111,8 +111,9 @@ def first_event(taken):
         pz, pv = plate(drv, clk, u + s * h)
         event = EV_NONE
         earliest = math.inf
+        pen, bound_now, spring = switch_values(kind, probe, t_base + (u + s * h), pz, pv, prm)
         for e in range(n_events):
-            g = value(kind, regime, e, probe, t_base + (u + s * h), pz, pv, prm)
+            g = event_value(event_at(regime, e), pen, bound_now, spring)
             if g < 0.0:
                 root = _interpolant_root(taken, e, previous, s, g)
                 if root < earliest:

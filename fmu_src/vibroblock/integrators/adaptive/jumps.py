@@ -42,7 +42,7 @@ from numba import njit
 
 from ...layout import P_ATOL, P_KD, P_MAX_JUMP, P_RTOL, P_VD
 from .methods import EVENT_SAMPLES, growth, sample_state, shrink, step
-from .regimes import NS, NV, events_of, plate, rates, value
+from .regimes import NS, NV, event_at, event_value, events_of, plate, rates, switch_values
 from .rodas4 import EPS, linearise
 from .workspace import F0, PROBE, SCRATCH, TRIAL
 
@@ -89,8 +89,9 @@ def _sample_margins(system, clk, explicit, start, end, ws, h, local, t_now, marg
         s = sample / EVENT_SAMPLES
         sample_state(explicit, start, end, ws, h, sample, row)
         pz, pv = plate(drv, clk, local + s * h)
+        pen, bound_now, spring = switch_values(kind, row, t_now + s * h, pz, pv, prm)
         for e in range(events_of(regime)[1]):
-            g = value(kind, regime, e, row, t_now + s * h, pz, pv, prm)
+            g = event_value(event_at(regime, e), pen, bound_now, spring)
             if g <= 0.0:
                 return False
             margins[e] = min(margins[e], g)
@@ -116,8 +117,9 @@ def period_map(system, v0, t_abs, shift, clk, plan, hs, n_hs, res, ws, tally):
         out[i] = 0.0
         probe[i] = v0[i]
     pz, pv = plate(drv, clk, 0.0)
+    pen, bound_now, spring = switch_values(kind, v0, t_abs + shift, pz, pv, prm)
     for e in range(events_of(regime)[1]):
-        margins[e] = value(kind, regime, e, v0, t_abs + shift, pz, pv, prm)
+        margins[e] = event_value(event_at(regime, e), pen, bound_now, spring)
         if margins[e] <= 0.0:
             return -1
     for i in range(NS):

@@ -172,10 +172,19 @@ def event_at(regime, i):
 
 
 @njit(inline="always")
+def switch_values(kind, v, t, pz, pv, prm):
+    """What every event value is made of at state v, time t, plate (pz, pv): the
+    penetration, the Coulomb bound and the friction spring's force.  A loop over a
+    regime's events takes them once (the compiler cannot hoist them past the law's call)."""
+    pen, bound_now = bound(kind, v, t, pz, pv, prm)
+    return pen, bound_now, friction_spring_force(kind, v[4], prm)
+
+
+@njit(inline="always")
 def value(kind, regime, i, v, t, pz, pv, prm):
     """The regime's i-th event value at state v, time t, plate (pz, pv)."""
-    pen, bound_now = bound(kind, v, t, pz, pv, prm)
-    return event_value(event_at(regime, i), pen, bound_now, friction_spring_force(kind, v[4], prm))
+    pen, bound_now, spring = switch_values(kind, v, t, pz, pv, prm)
+    return event_value(event_at(regime, i), pen, bound_now, spring)
 
 
 @njit(inline="always")

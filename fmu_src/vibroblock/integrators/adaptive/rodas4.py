@@ -191,13 +191,13 @@ def rosenbrock(system, clk, v, t_abs, u, h, ws, out):
 @njit(inline="always")
 def dense(v, out, ws, s, res):
     """The step's interpolant at fraction s of the step (state components)."""
-    k = ws[0][K:K + 6]
+    rows = ws[0]  # indexed in place: a view per call costs reference counting in the event loop
     for i in range(NS):
         w2 = 0.0
         w3 = 0.0
         for j in range(5):
-            w2 += DENSE[0, j] * k[j, i]
-            w3 += DENSE[1, j] * k[j, i]
+            w2 += DENSE[0, j] * rows[K + j, i]
+            w3 += DENSE[1, j] * rows[K + j, i]
         res[i] = (1.0 - s) * v[i] + s * (out[i] + (1.0 - s) * (w2 + s * w3))
 
 
