@@ -15,6 +15,7 @@ import numpy as np
 from .integrators import INTEGRATORS, REDUCED_SCENE, Integrator, integrator as integrator_record
 from .models import offered_by, variant
 from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS, reading_names
+from .laws import AXES, LAWS
 from .readings import choices, encode
 from .scenes import COULOMB, FROZEN, RIGID
 
@@ -191,6 +192,12 @@ class Settings:
         problem = record.unsupported_reading(self.readings)
         if problem:
             raise ModelError(f"the {record.name} integrator {problem}; choose symplectic_euler or rk4")
+        for axis in AXES.values():  # a law that states which integrators cannot run it
+            if axis.parameter in self.readings:
+                chosen = LAWS[axis.name][self.readings[axis.parameter]]
+                if record.name in chosen.refused_by:
+                    raise ModelError(f"the {record.name} integrator cannot run {axis.parameter} = "
+                                     f"{chosen.id} ({chosen.name}): {chosen.refused_by[record.name]}")
         problem = record.check_step(self.parameters, self.model, record.name)
         if problem:
             raise ModelError(problem)
