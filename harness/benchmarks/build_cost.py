@@ -13,7 +13,8 @@ Prints, in one run:
    process: cold (empty numba cache: the FMU's shipped kernels are all it has) and warm
    (the cache the cold run left); the time from instantiate to the end of the first
    doStep, split into instantiate (the core's imports: numba, scipy, the core), initialize
-   (the run's kernels loaded, or compiled) and the doStep itself;
+   (the run's kernels loaded, or compiled) and the doStep itself; and numba's own floor
+   (its import, and a trivial cached kernel's first call, which sets up its target context);
 4. the cold first doStep of configurations that are not a default: each other integrator
    of BlockA (and adaptive's own steps on B), and a non-default reading and law on B,
    each in a fresh process with an empty cache (what it compiles is kept in that cache);
@@ -98,7 +99,7 @@ slave.doStep(0.0, 0.5)
 end = time.perf_counter()
 x = slave.getReal([vr["x"][0]])[0]
 print(json.dumps({"first_step": end - start, "instantiate": instantiated - start, "initialize": step - instantiated,
-                  "do_step": end - step, "process": end - begin, "x": x}), flush=True)
+                  "do_step": end - step, "process": end - begin, "cpu": time.process_time(), "x": x}), flush=True)
 os._exit(0)  # (the embedded interpreter's teardown is not what is measured)
 """
 
@@ -173,12 +174,36 @@ def first_step(fmu: Path, cache: Path, settings: dict, scratch: Path) -> dict:
 
 def _row(label: str, result: dict) -> str:
     return (f"   {label:44} {result['first_step']:6.2f} s = instantiate {result['instantiate']:5.2f} + initialize "
-            f"{result['initialize']:5.2f} + doStep {result['do_step']:5.3f}  (process {result['wall']:.1f} s)")
+            f"{result['initialize']:5.2f} + doStep {result['do_step']:5.3f}  (process {result['wall']:.1f} s wall, "
+            f"{result['cpu']:.1f} s CPU)")
+
+
+# Child: numba's own floor for a first call, a trivial cached kernel (import, then the first
+# call: numba's target context is set up by the first kernel a process loads or compiles).
+FLOOR = r"""
+import json, time
+begin = time.perf_counter()
+from numba import njit
+imported = time.perf_counter()
+@njit(cache=True)
+def one(x):
+    return x + 1
+one(1)
+print(json.dumps([imported - begin, time.perf_counter() - imported]))
+"""
 
 
 def first_steps(fmu_dir: Path, scratch: Path) -> None:
     print("\n3. first doStep of each Block FMU's default configuration through fmpy, fresh process, from "
           "instantiate to the end of the first doStep (target cold <= 1 s)")
+    floor_dir = scratch / "floor"
+    floor_dir.mkdir()
+    (floor_dir / "floor.py").write_text(FLOOR)  # (numba caches kernels of files only)
+    for label in ("compiled", "cached"):
+        out = subprocess.run([sys.executable, "floor.py"], env=_child_env(scratch / "cache-floor", floor_dir),
+                             cwd=floor_dir, capture_output=True, text=True, check=True)
+        imported, called = json.loads(out.stdout.strip().splitlines()[-1])
+        print(f"   numba's floor: import {imported:.2f} s, first call of a trivial kernel ({label}) {called:.2f} s")
     for fmu in sorted(fmu_dir.glob("Block*.fmu")):
         cache = scratch / f"cache-{fmu.stem}"
         print(_row(f"{fmu.stem} default, cold (empty cache)", first_step(fmu, cache, {}, scratch)))
