@@ -113,15 +113,18 @@ def kernel_jobs() -> list[str]:
 
 
 def shipped_jobs(model: str) -> list[str]:
-    """The jobs whose kernels the Block FMU of ``model`` ships: those its default
-    configuration runs, the chosen integrator's own where it hands the run over, and
-    ``SHIPPED_ALWAYS`` where the model offers it."""
+    """The jobs whose kernels the Block FMU of ``model`` ships: for its default integrator
+    and each of ``SHIPPED_ALWAYS`` the model offers, the kernels it runs in the default
+    configuration (where it hands the run over, e.g. adaptive on model A to
+    event_driven's exact flows, those) and its own."""
     from vibroblock import Block
-    from vibroblock.integrators import BY_ID, integrator
+    from vibroblock.integrators import BY_ID, INTEGRATORS, integrator
 
-    settings = Block(model).settings
-    ids = {settings.kernel().id, integrator(settings.integrator).id}
-    ids |= {record.id for record in BY_ID.values() if record.name in SHIPPED_ALWAYS and record.supports(model)}
+    names = {Block(model).settings.integrator} | {
+        name for name in SHIPPED_ALWAYS if name in INTEGRATORS and integrator(name).supports(model)}
+    ids = set()
+    for name in names:
+        ids |= {Block(model, name).settings.kernel().id, integrator(name).id}
     return sorted(BY_ID[i].name for i in ids)
 
 
