@@ -263,8 +263,8 @@ class SpeedChild:
 
 def step_speed(commit: str, rounds: int) -> None:
     print(f"\n5. step speed against the previous release {commit}, same scenarios (scaled stick-slip, "
-          f"vibrating A = 0.3, omega = 0.8, dt = {DT}), CPU seconds, in turns, best of {rounds} "
-          "(target: ratio >= 0.9)")
+          f"vibrating A = 0.3, omega = 0.8, dt = {DT}; B and C with contact_law = 1, the release's contact), "
+          f"CPU seconds, in turns, best of {rounds} (target: ratio >= 0.9; |dx|: x at t_end, the two apart)")
     print(f"   {'model':5} {'integrator':17} {'t_end':>7} {'previous':>9} {'this':>9} {'ratio':>6} "
           f"{'|dx|':>8}")
     work = ROOT / "build" / "work"
@@ -273,10 +273,14 @@ def step_speed(commit: str, rounds: int) -> None:
     try:
         for model, integrator, t_end in SPEED_SCENARIOS:
             scenario = [model, integrator, t_end, dict(VIBRATING, dt=DT)]
+            # The release's contact on a corrugated plate is today's contact_law = 1 (the
+            # default became the conservative one): the same physics on both sides.
+            release_law = {"contact_law": 1} if model != "A" else {}
+            same_law = [model, integrator, t_end, dict(VIBRATING, dt=DT, **release_law)]
             best_ours, best_theirs = float("inf"), float("inf")
             for _ in range(rounds):
                 seconds_theirs, x_theirs = theirs.seconds(scenario)
-                seconds_ours, x_ours = ours.seconds(scenario)
+                seconds_ours, x_ours = ours.seconds(same_law)
                 best_ours, best_theirs = min(best_ours, seconds_ours), min(best_theirs, seconds_theirs)
             print(f"   {model:5} {integrator:17} {t_end:7g} {best_theirs:8.3f}s {best_ours:8.3f}s "
                   f"{best_theirs / best_ours:6.2f} {abs(x_ours - x_theirs):8.1e}")
