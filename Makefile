@@ -13,7 +13,7 @@ INSTALLED := $(VENV)/.installed
 # process per core (build/kernels.py, kept in build/work/ for the tests); each Block FMU
 # ships its default configuration's.
 FMUS := build/fmus/.built
-FMU_SOURCES := $(shell find fmu_src -name '*.py' -o -name '*.npz') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c \
+FMU_SOURCES := $(shell find fmu_src harness/ground/records -name '*.py' -o -name '*.npz') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c \
 	build/python_runtime.c build/python_runtime.h build/kernels.py build/documentation.py
 
 .PHONY: setup fmus run test benchmark clean

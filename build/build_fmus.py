@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import shutil
 import sys
 import sysconfig
 import tempfile
@@ -36,6 +37,8 @@ from xml.etree import ElementTree
 ROOT = Path(__file__).resolve().parent.parent
 SOURCES = ROOT / "fmu_src"
 CORE = SOURCES / "vibroblock"
+# The ground-motion record package (relative imports only), bundled in the Excitation FMU.
+RECORDS = ROOT / "harness" / "ground" / "records"
 DEFAULT_DEST = ROOT / "build" / "fmus"
 FIXED_TIMESTAMP = (1980, 1, 1, 0, 0, 0)  # the earliest a zip archive can record
 BLOCK_SCRIPT = '''"""FMU: {description} (vibroblock, a spring-block on a vibrating plate)."""
@@ -162,7 +165,12 @@ def build(name: str, dest: Path, ship_kernels: bool = True) -> Path:
             script.write_text(generated[name])
         elif not script.is_file():
             raise SystemExit(f"no FMU named {name!r}; the FMUs are {fmu_names()}")
-        fmu = FmuBuilder.build_FMU(script, dest=dest, project_files=[CORE],
+        project_files = [CORE]
+        if name == "Excitation":  # it processes seismic records itself: harness.ground.records, bundled
+            records = Path(scratch) / "vibroblock_records"
+            shutil.copytree(RECORDS, records, ignore=shutil.ignore_patterns("__pycache__"))
+            project_files.append(records)
+        fmu = FmuBuilder.build_FMU(script, dest=dest, project_files=project_files,
                                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
     fmu = Path(fmu)
     from status_shim import wrap_fmu

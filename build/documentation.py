@@ -38,7 +38,8 @@ block (<code>a = arctan dZ_p/dx</code>):</p>
 plate <code>u_n = (r' - V_p e_z) . n</code>, <code>u_t = (r' - V_p e_z) . t</code>.</li>
 <li>Friction (Cundall-Strack): <code>dF/dt = u_t</code> while <code>delta &gt; 0</code>; <code>F = 0</code> out of
 contact and whenever <code>|k_t F| &gt;= mu_s N</code> (a Coulomb reset, counted in
-<code>slip_count</code>).</li>
+<code>coulomb_resets</code>; <code>slip_count</code> is its old name, kept for one release). A slip of
+the block holds many resets: slips are counted from the motion, not by the FMU.</li>
 <li>Units: <code>m = g = k_n = 1</code>; lengths in <code>delta_0 = m g / k_n</code>, times in
 <code>tau_0 = sqrt(m / k_n)</code>. Source: F. Giacco, E. Lippiello, M. Pica Ciamarra,
 <i>Solid-on-solid single block dynamics under mechanical vibration</i>.</li>
@@ -104,7 +105,7 @@ def _integrators() -> list[tuple[str, str]]:
 
 
 def block_html(model: str, identifier: str) -> str:
-    from vibroblock.interface import ENERGY_BALANCE, INPUTS, OUTPUTS
+    from vibroblock.interface import DEFAULT_INTEGRATOR_ID, DEFAULT_INTEGRATOR_TEXT, ENERGY_BALANCE, INPUTS, OUTPUTS
     from vibroblock.models import DESCRIPTIONS, defaults, offered_by, parameters_for
     from vibroblock.parameters import INITIAL_STATES, SCENE_OPTIONS
 
@@ -112,7 +113,8 @@ def block_html(model: str, identifier: str) -> str:
     rows = [(f"<code>{_e(p.name)}</code>", _e(p.unit), f"{values[p.name]:g}",
              "tunable" if p.tunable else "fixed", _e(p.description)) for p in parameters_for(model)]
     integrators = _integrators()
-    options = [("<code>integrator</code>", "Integer", "0", "fixed", "see Integrators"),
+    options = [("<code>integrator</code>", "Integer", str(DEFAULT_INTEGRATOR_ID), "fixed",
+                f"see Integrators; {_e(DEFAULT_INTEGRATOR_TEXT)}"),
                ("<code>initial_state</code>", "Integer", "0", "fixed",
                 "<br>".join(f"{i} = {_e(text)}" for i, text in INITIAL_STATES.items())),
                ("<code>energy_balance</code>", "Boolean", "false", "fixed", _e(ENERGY_BALANCE))]
@@ -170,8 +172,10 @@ Block FMUs: <code>plate_z = amplitude_scale * w(s) * f(s)</code> with signal tim
 acceleration integrated exactly, at rest outside the record.</li></ul>
 <h2>Parameters</h2>
 {_table(("name", "unit", "default", "meaning"), rows)}
-<p><code>record_file</code> (String): a <code>.npz</code> or two-column text record; empty for the
-bundled record.</p>
+<p><code>record_file</code> (String): a <code>.npz</code> or two-column text record, or a seismic record in
+any format obspy reads (MiniSEED, SAC, GSE2, ..., PEER <code>.AT2</code>), processed at initialization to
+consistent SI motion (response removed with <code>record_inventory</code>, a StationXML, RESP or dataless
+SEED file, for a record in counts); empty for the bundled record.</p>
 {PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
 </body></html>
 """

@@ -87,16 +87,20 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockC.fmu", scenarios=("C sti
     return results
 
 
-def main():
+def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu", default=str(ROOT / "build" / "fmus" / "BlockC.fmu"))
+    parser.add_argument("--fmu", default=str(ROOT / "build" / "fmus" / "BlockC.fmu"),
+                        help="BlockC.fmu to run (default: build/fmus/BlockC.fmu of this repository, built by "
+                             "'make fmus')")
     parser.add_argument("--scenario", action="append", choices=["C stick-slip", "C sub-threshold", "C stick",
                                                                  "C bouncing"],
                         help="a scene of the work-precision benchmark (repeatable; default: stick-slip and "
                              "sub-threshold)")
-    args = parser.parse_args()
-    run_experiment(args.fmu, tuple(args.scenario or ("C stick-slip", "C sub-threshold")))
+    args = parser.parse_args(argv)
+    from harness.user_errors import require_fmu, run_main
+    return run_main("choosing_an_integrator.py", lambda: run_experiment(
+        require_fmu(args.fmu), tuple(args.scenario or ("C stick-slip", "C sub-threshold"))) and 0)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -40,6 +40,14 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     table = result.to_markdown()
     print(header)
     print(table)
+    print("What the columns mean: phase = when the record's peak hits, as a share of the stick (0: just after a "
+          "slip, 1: at the next one); stress ratio = k_t F / (mu_s m g) then, how close the friction spring is to "
+          "breaking; peak a and down peak = the record's largest and most negative plate acceleration [g]; "
+          "predicted reset / lift-off = the peak that breaks the spring / lifts the block off at that phase [g]; "
+          "resets = Coulomb resets (breaks of the friction spring) while the record plays; jump = largest travel "
+          "beyond the unshaken run in that time [delta_0]; contact = share of the record's time in contact; clock "
+          "advance = how much earlier the next slip came than without the record [tau_0] (> 0: earlier), and as a "
+          "share of the stick T; slip = length of that slip [delta_0]; outcome = what the record did.")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     result.to_csv(out_dir / "triggering.csv")
@@ -61,8 +69,8 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     p = np.linspace(0.0, 1.0, 2)
     left.plot(p, 1.0 - p, "k:", lw=0.8, label="slip at the peak: 1 − phase")
     left.axhline(0.0, color="k", lw=0.5)
-    left.set_xlabel("phase of the stick when the record peaks")
-    left.set_ylabel("clock advance / stick time")
+    left.set_xlabel("phase of the stick when the record peaks [1]")
+    left.set_ylabel("clock advance / stick time [1]")
     left.legend(fontsize=7, title="peak |a|", title_fontsize=7)
     left.set_title("slip brought forward (> 0) or delayed (< 0)")
 
@@ -76,7 +84,7 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     right.plot(phases_sorted, liftoff, "k--", lw=1, label="predicted lift-off")
     for outcome, (marker, color) in MARKERS.items():
         right.plot([], [], marker=marker, color=color, ls="none", label=outcome)
-    right.set_xlabel("phase of the stick when the record peaks")
+    right.set_xlabel("phase of the stick when the record peaks [1]")
     right.set_ylabel("peak plate acceleration [g]")
     right.set_yscale("log")
     right.legend(fontsize=7)
@@ -92,11 +100,19 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockA.fmu", out_dir=ROOT / "o
     return result
 
 
-if __name__ == "__main__":
+def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu", type=Path, default=ROOT / "build" / "fmus" / "BlockA.fmu")
-    parser.add_argument("--out", type=Path, default=ROOT / "out")
+    parser.add_argument("--fmu", type=Path, default=ROOT / "build" / "fmus" / "BlockA.fmu",
+                        help="BlockA.fmu to run (default: build/fmus/BlockA.fmu of this repository, built by "
+                             "'make fmus')")
+    parser.add_argument("--out", type=Path, default=ROOT / "out",
+                        help="folder for triggering.png, .csv and .md (default: out/)")
     parser.add_argument("--quick", action="store_true", help="three phases and three amplitudes only")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     quick = {"phases": (0.3, 0.7, 0.9), "peak_accelerations": (0.001, 0.3, 0.9)} if args.quick else {}
-    run_experiment(args.fmu, args.out, **quick)
+    from harness.user_errors import require_fmu, run_main
+    return run_main("triggering.py", lambda: run_experiment(require_fmu(args.fmu), args.out, **quick) and 0)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

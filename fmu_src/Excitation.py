@@ -9,7 +9,8 @@ from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
 from pythonfmu.variables import Integer, Real, String
 
-from vibroblock.excitation import BUNDLED_RECORD, PARAMETERS, PLAYBACK, Excitation as Plate, ExcitationError
+from vibroblock.excitation import (BUNDLED_RECORD, PARAMETERS, PLAYBACK, TEXT_SUFFIXES, Excitation as Plate,
+                                   ExcitationError, Playback)
 from vibroblock.fmi import FmuFacade, fmu_class
 
 OUTPUTS = {
@@ -25,7 +26,17 @@ MODE_TEXT = ("signal f of signal time s = (t - onset)/time_scale; plate_z = ampl
              "acceleration integrated exactly; at rest outside the record)")
 RECORD_TEXT = ("record for mode 4: path of a .npz (dt, acceleration[, velocity0, displacement0]) or two-column "
                "text file (time, acceleration), in units made model units by amplitude_scale and time_scale; "
+               "or a seismic record in any format obspy reads (MiniSEED, SAC, GSE2, ..., or PEER .AT2), processed "
+               "when the FMU is initialized to consistent SI acceleration, velocity and displacement (response "
+               "removed with record_inventory, band 0.1 Hz to 0.4 x the sampling rate, baseline corrected; "
+               "one channel, or the vertical one); "
                f"empty: the bundled record {BUNDLED_RECORD.name} (BW.RJOB vertical, 2009-08-24, SI units)")
+INVENTORY_TEXT = ("instrument response of a seismic record_file in counts: path of a StationXML, RESP or dataless "
+                  "SEED file (empty: the record's own units, if it has physical ones)")
+# Record files the core plays as they are (vibroblock.excitation.load_record); any other is
+# read and processed as a seismic record (the bundled vibroblock_records package, which is
+# harness.ground.records).
+PLAIN_RECORDS = (".npz", *TEXT_SUFFIXES)
 
 
 class ExcitationFacade(FmuFacade):
@@ -40,6 +51,8 @@ class ExcitationFacade(FmuFacade):
                             "acceleration, for the plate inputs of the vibroblock Block FMUs.")
         self.bundled = self._bundled_record(kwargs.get("resources"))
         self.plate = Plate(bundled=self.bundled)
+        self.seismic_record = ""  # a record_file processed at initialization (see _start)
+        self.record_inventory = ""
         self._cache = None  # (time, outputs): the three getters of one step share one evaluation
         self._register_interface()
 
@@ -65,9 +78,13 @@ class ExcitationFacade(FmuFacade):
                 getter=lambda name=spec.name: self.plate.parameters[name],
                 setter=lambda value, name=spec.name: self._guard(self.plate.set_parameter, name, value)))
         self.register_variable(String(
+            "record_inventory", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description=INVENTORY_TEXT, getter=lambda: self.record_inventory,
+            setter=lambda value: self._guard(self._set_inventory, value)))
+        self.register_variable(String(
             "record_file", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-            description=RECORD_TEXT, getter=lambda: self.plate.record_file,
-            setter=lambda value: self._guard(self.plate.set_record_file, value)))
+            description=RECORD_TEXT, getter=lambda: self.seismic_record or self.plate.record_file,
+            setter=lambda value: self._guard(self._set_record_file, value)))
         for name, text in OUTPUTS.items():
             self.register_variable(Real(
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
@@ -88,6 +105,55 @@ class ExcitationFacade(FmuFacade):
             self._cache = (time, values)
         return self._cache[1][name]
 
+    def _set_inventory(self, path: str) -> None:
+        if self.plate.started:
+            raise ExcitationError("record_inventory is fixed once the run has started")
+        if path and not Path(path).is_file():
+            raise ExcitationError(f"record_inventory = {path!r} does not exist (or is not a file): give the path of "
+                                  "a StationXML, RESP or dataless SEED file, or leave it empty")
+        self.record_inventory = str(path)
+
+    def _set_record_file(self, path: str) -> None:
+        """A plain record goes to the core, which reads it at once; a seismic one is
+        checked to exist and processed when the FMU is initialized (the inventory may
+        come after it)."""
+        if not path or Path(path).suffix.lower() in PLAIN_RECORDS:
+            self.plate.set_record_file(path)
+            self.seismic_record = ""
+            return
+        if self.plate.started:
+            raise ExcitationError("record_file is fixed once the run has started")
+        if not Path(path).is_file():
+            raise ExcitationError(f"record_file = {path!r} does not exist (or is not a file): give the path of an "
+                                  f"existing record file, absolute or relative to the master's working directory "
+                                  f"({Path.cwd()}), or leave it empty for the bundled record")
+        self.seismic_record = str(path)
+
+    def _seismic_playback(self) -> Playback:
+        """The seismic record_file processed to SI (harness.ground.records, bundled)."""
+        try:
+            from vibroblock_records import RecordError, load_ground_motion
+        except ImportError:  # a process that has the harness: the same package
+            try:
+                from harness.ground.records import RecordError, load_ground_motion
+            except ImportError as exc:
+                raise ExcitationError(f"record_file = {self.seismic_record!r} is a seismic record, which needs obspy "
+                                      f"in the FMU's Python environment ({exc}); install it (pip install obspy) or "
+                                      "convert the record with 'vibroblock record FILE --save-record record.npz'") \
+                    from None
+        try:
+            motion = load_ground_motion(self.seismic_record, inventory=self.record_inventory or None)
+        except RecordError as exc:
+            if "no instrument response" in str(exc):
+                raise ExcitationError(
+                    f"record_file = {self.seismic_record!r} holds counts without an instrument response, which have "
+                    "no physical meaning: set record_inventory to its StationXML, RESP or dataless SEED file, or "
+                    "convert it with 'vibroblock record FILE --sensitivity COUNTS_PER_UNIT --quantity Q --unit U "
+                    "--save-record record.npz' and play that") from None
+            raise ExcitationError(f"record_file = {self.seismic_record!r}: {exc}") from None
+        return Playback(motion.acceleration, motion.dt, motion.velocity[0], motion.displacement[0],
+                        source=self.seismic_record)
+
     # ------------------------------------------------------------------ facade hooks
     def _changed(self) -> None:
         self._cache = None
@@ -99,6 +165,8 @@ class ExcitationFacade(FmuFacade):
         return self.plate.time
 
     def _start(self, start_time: float) -> None:
+        if self.seismic_record and self.plate.mode == PLAYBACK:
+            self.plate.use_record(self._seismic_playback(), name=self.seismic_record)
         self.plate.start(start_time)
         if self.plate.mode == PLAYBACK:
             problems = self.plate.playback().rest_problems()

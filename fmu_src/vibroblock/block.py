@@ -31,11 +31,12 @@ STEP_BUDGET_PER_CALL = 2**36
 FMI_INTEGER_MAX = 2**31 - 1
 # The outputs that are plain entries of the observation in every reading: a native front
 # end may read them without Python (vibroblock.native; _observables is the reference).
-# The Boolean contact and the Integer slip_count are stored as 0.0/1.0 and a whole count;
+# The Boolean contact and the Integer coulomb_resets (and its old name slip_count) are stored as 0.0/1.0 and a whole count;
 # the front end converts them as _observables does (!= 0, truncation).
 OBSERVED_OUTPUTS = {"x": L.O_X, "friction_force": L.O_FRICTION, "normal_force": L.O_NORMAL,
                     "phi_integral": L.O_PHI, "penetration": L.O_PENETRATION, "work_input": L.O_WORK,
-                    "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "slip_count": L.O_SLIPS}
+                    "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "coulomb_resets": L.O_SLIPS,
+                    "slip_count": L.O_SLIPS}
 # ... and in the model's own reading, where the state is the point itself.
 OBSERVED_POINT = {"z": L.O_Z, "vx": L.O_VX, "vz": L.O_VZ, "surface_z": SURFACE_Z}
 
@@ -355,7 +356,8 @@ class Block:
                 "friction_force": float(obs[L.O_FRICTION]),
                 "normal_force": float(obs[L.O_NORMAL]),
                 "contact": bool(obs[L.O_CONTACT] != 0.0),
-                "slip_count": int(obs[L.O_SLIPS]),
+                "coulomb_resets": int(obs[L.O_SLIPS]),
+                "slip_count": int(obs[L.O_SLIPS]),  # the old name of coulomb_resets (interface.OUTPUT_ALIASES)
                 "phi_integral": float(obs[L.O_PHI]),
                 "penetration": float(pen),
                 "surface_z": float(surface_z),

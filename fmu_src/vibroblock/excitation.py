@@ -271,7 +271,9 @@ def load_record(path: str | Path = "", bundled: str | Path = BUNDLED_RECORD) -> 
     path = Path(path) if str(path) else Path(bundled)
     where = str(path)
     if not path.is_file():
-        raise ExcitationError(f"record file {where!r} does not exist (or is not a file)")
+        raise ExcitationError(f"record_file = {where!r} does not exist (or is not a file): give the path of an "
+                              f"existing record file, absolute or relative to the master's working directory "
+                              f"({Path.cwd()}), or leave it empty for the bundled record")
     try:
         if path.suffix.lower() == ".npz":
             return _load_npz(path)
@@ -281,8 +283,11 @@ def load_record(path: str | Path = "", bundled: str | Path = BUNDLED_RECORD) -> 
         raise
     except Exception as exc:  # numpy raises many types for unreadable files
         raise ExcitationError(f"cannot read record file {where!r}: {exc}") from None
-    raise ExcitationError(f"record file {where!r}: unknown format; use .npz (dt, acceleration) or "
-                          f"two-column text ({', '.join(TEXT_SUFFIXES)}: time, acceleration)")
+    raise ExcitationError(f"record_file = {where!r} is not a record the FMU plays (unknown format; it plays .npz "
+                          f"with dt and acceleration, or two-column text {', '.join(TEXT_SUFFIXES)}: time, "
+                          f"acceleration); a seismic record (SAC, MiniSEED, ... in counts or physical units) becomes "
+                          f"one with 'vibroblock record FILE --save-record record.npz' (response removed, processed, "
+                          f"SI)")
 
 
 def _load_npz(path: Path) -> Playback:

@@ -4,7 +4,7 @@ The README's interface table is this module's output; a test keeps the two equal
 """
 from .integrators import INTEGRATOR_RECORDS, INTEGRATORS
 from .models import VARIANTS, offered_by
-from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS
+from .parameters import DEFAULT_INTEGRATOR, INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS
 from .readings import choices
 
 CHOICES = choices()  # the readings and the laws
@@ -24,8 +24,12 @@ OUTPUTS = {
                        "tangential spring force -k_t F along the plate's tangent, 0 out of contact"),
     "normal_force": ("Real", "m_0 delta_0/tau_0^2", "normal contact force k_n delta - gamma_n u_n, 0 out of contact"),
     "contact": ("Boolean", "", "block penetrates the plate (delta > 0)"),
-    "slip_count": ("Integer", "", "Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since the start; "
-                   "of a cascade of resets before a detachment, as many as the integrator resolves"),
+    "coulomb_resets": ("Integer", "", "Coulomb resets of the loaded tangential spring (|k_t F| >= mu_s N) since "
+                       "the start; a slip of the block holds many (the spring rings and breaks again), and of a "
+                       "cascade of resets before a detachment the count holds as many as the integrator resolves. "
+                       "Slips are counted from the motion (harness.runs.observables)"),
+    "slip_count": ("Integer", "", "old name of coulomb_resets, the same value (kept for one release): it counts "
+                   "Coulomb resets, not slips"),
     "phi_integral": ("Real", "delta_0^2/tau_0", "integral of (vx - V_d)^2 dt since the start"),
     "penetration": ("Real", "delta_0", "penetration delta along the surface normal, > 0 in contact: (Z_p - z) cos(alpha) "
                     "(formulation 0), P(t) - zeta (formulation 1, zeta the block's normal coordinate)"),
@@ -55,6 +59,12 @@ OUTPUTS = {
 COST_OUTPUTS = {"accepted_steps": "accepted", "rejected_steps": "rejected", "located_events": "events",
                 "jacobian_evaluations": "jacobians", "periods_jumped": "periods_jumped"}
 INTEGRATOR_CHOICES = ", ".join(f"{i} = {name}" for name, i in INTEGRATORS.items())
+# The outputs kept under an old name for one release: old name -> new name.
+OUTPUT_ALIASES = {"slip_count": "coulomb_resets"}
+DEFAULT_INTEGRATOR_ID = INTEGRATORS[DEFAULT_INTEGRATOR]
+DEFAULT_INTEGRATOR_TEXT = (f"default {DEFAULT_INTEGRATOR_ID} = {DEFAULT_INTEGRATOR} on every model: on model A it "
+                           "takes event_driven's exact flows (option exact_flows), on models B and C "
+                           "error-controlled steps; 0 = symplectic_euler is the paper's first-order scheme")
 ENERGY_BALANCE = "account work, dissipation and stored energy (outputs work_input, energy_dissipated, " \
     "energy_residual; about a third more time per step)"
 INITIAL_CHOICES = "; ".join(f"{i} = {text}" for i, text in INITIAL_STATES.items())
@@ -96,7 +106,8 @@ def markdown_table() -> str:
             default += f" ({', '.join(overridden)}: {defaults[overridden[0]]:g})"
         rows.append(f"| `{p.name}` | {kind} | {_models_column(sorted(defaults))} | {p.unit} | {default} | "
                     f"{p.description} |")
-    rows.append(f"| `integrator` | parameter (Integer) | {every} | | 0 | {INTEGRATOR_CHOICES} |")
+    rows.append(f"| `integrator` | parameter (Integer) | {every} | | {DEFAULT_INTEGRATOR_ID} | {INTEGRATOR_CHOICES} "
+                f"({DEFAULT_INTEGRATOR_TEXT}) |")
     for name, (models, default, text) in INTEGRATOR_OPTIONS.items():
         rows.append(f"| `{name}` | parameter (Boolean) | {_models_column(offered_by(models))} | | "
                     f"{str(default).lower()} | {text} |")

@@ -14,7 +14,8 @@ import numpy as np
 
 from .integrators import INTEGRATORS, REDUCED_SCENE, Integrator, integrator as integrator_record
 from .models import offered_by, variant
-from .parameters import INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS, reading_names
+from .laws import AXES, LAWS
+from .parameters import DEFAULT_INTEGRATOR, INITIAL_STATES, INTEGRATOR_OPTIONS, SCENE_OPTIONS, reading_names
 from .readings import choices, encode
 from .scenes import COULOMB, FROZEN, RIGID
 
@@ -191,6 +192,12 @@ class Settings:
         problem = record.unsupported_reading(self.readings)
         if problem:
             raise ModelError(f"the {record.name} integrator {problem}; choose symplectic_euler or rk4")
+        for axis in AXES.values():  # a law that states which integrators cannot run it
+            if axis.parameter in self.readings:
+                chosen = LAWS[axis.name][self.readings[axis.parameter]]
+                if record.name in chosen.refused_by:
+                    raise ModelError(f"the {record.name} integrator cannot run {axis.parameter} = "
+                                     f"{chosen.id} ({chosen.name}): {chosen.refused_by[record.name]}")
         problem = record.check_step(self.parameters, self.model, record.name)
         if problem:
             raise ModelError(problem)
@@ -216,9 +223,13 @@ class Settings:
         if self.scene["rigid_contact"] and self.scene["frozen_vertical"]:
             raise ModelError("rigid_contact and frozen_vertical exclude each other (a rigid contact has no "
                              "compliant orbit to freeze); choose one")
-        if (self.scene["rigid_contact"] or self.scene["coulomb_friction"]) and self.integrator != "symplectic_euler":
-            raise ModelError(f"rigid_contact and coulomb_friction run on their own first-order kernel; set "
-                             f"integrator = symplectic_euler (0), not {self.integrator}")
+        # The FMUs' default integrator is accepted too: a master that did not choose one must
+        # not be refused, and the reduced scene's kernel runs either way.
+        if ((self.scene["rigid_contact"] or self.scene["coulomb_friction"])
+                and self.integrator not in ("symplectic_euler", DEFAULT_INTEGRATOR)):
+            raise ModelError(f"integrator = {self.integrator} cannot run with rigid_contact or coulomb_friction: "
+                             f"those run on their own first-order kernel; set integrator = symplectic_euler (0) or "
+                             f"leave the default ({DEFAULT_INTEGRATOR})")
         p, dt = self.parameters, self.parameters["dt"]
         kept = [("drive spring", p["k_d"], 0.0)]
         if not self.scene["coulomb_friction"]:

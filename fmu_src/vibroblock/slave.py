@@ -18,12 +18,13 @@ from pythonfmu.variables import Boolean, Integer, Real
 
 from .block import Block
 from .fmi import TIME_TOLERANCE, FmuFacade, fmu_class
-from .interface import CHOICES, ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES, OUTPUTS, reading_choices
+from .interface import (CHOICES, DEFAULT_INTEGRATOR_TEXT, ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES,
+                        OUTPUTS, reading_choices)
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
 from .integrators import INTEGRATORS
 from .models import offered_by, variant
 from .native import NativeStep
-from .parameters import INTEGRATOR_OPTIONS, SCENE_OPTIONS
+from .parameters import DEFAULT_INTEGRATOR, INTEGRATOR_OPTIONS, SCENE_OPTIONS
 from .settings import ModelError
 
 
@@ -41,7 +42,8 @@ class BlockFacade(FmuFacade):
         # (vibroblock.native); it outlives the Blocks an FMU state restore replaces.
         self._native_step = NativeStep()
         self.native_step = ctypes.addressof(self._native_step)
-        self.block = Block(self.model)
+        # Where the master does not choose, the recommended integrator runs (parameters.DEFAULT_INTEGRATOR).
+        self.block = Block(self.model, DEFAULT_INTEGRATOR)
         self.plate_input = {name: 0.0 for name in INPUTS}
         self._input_changed = False
         self._healthy = self._check_core(kwargs.get("resources"))
@@ -61,7 +63,7 @@ class BlockFacade(FmuFacade):
                 setter=lambda value, name=spec.name: self._guard(self.block.set_parameter, name, value)))
         self.register_variable(Integer(
             "integrator", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-            description=f"internal integrator: {INTEGRATOR_CHOICES}",
+            description=f"internal integrator: {INTEGRATOR_CHOICES} ({DEFAULT_INTEGRATOR_TEXT})",
             getter=lambda: INTEGRATORS[self.block.integrator],
             setter=lambda value: self._guard(self.block.set_integrator, int(value))))
         for name, (models, _, text) in INTEGRATOR_OPTIONS.items():  # only the options this model offers

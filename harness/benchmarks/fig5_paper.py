@@ -3,6 +3,7 @@ drawn where its points finish, its cost measured point by point.
 
     python -m harness.benchmarks.fig5_paper [--workers 2] [--cap 10] [--cycles 3] [--grid 8]
                                             [--formulations 0 1] [--rtol 1e-6] [--out out]
+                                            [--contact-law linear]
 
 Model C at the paper's parameters, which are the FMU's defaults (k_d = 5e-6, V_d = 2e-4,
 A_x = 1e3, omega_x = 2e-2, P_l = 1; m = k_n = 1, k_t = 0.28, gamma_n = 0.07,
@@ -95,7 +96,7 @@ def unit_time(omega: float, amplitude: float, p: dict) -> float:
 
 def run_point(args):
     """One grid point for (cycles + 1.5) units or ``cap`` seconds of wall time, whichever comes first."""
-    formulation, omega, amplitude, cap, rtol, cycles = args
+    formulation, omega, amplitude, cap, rtol, cycles, contact_law = args
     from vibroblock import Block, ModelError
 
     p = paper_parameters()
@@ -103,7 +104,7 @@ def run_point(args):
     t0 = CREST / p["V_d"]
     window_start, end = t0 + 0.5 * unit, t0 + (cycles + 1.5) * unit
     block = Block("C", "adaptive", initial_state=2, A=amplitude, omega=omega, x_start=CREST, dt=DT,
-                  formulation=formulation, rtol=rtol, atol=1e-2 * rtol)
+                  formulation=formulation, rtol=rtol, atol=1e-2 * rtol, contact_law=contact_law)
     started, cpu_started = time.perf_counter(), time.process_time()
     block.start(t0)
     x0 = block.output("x")
@@ -217,6 +218,8 @@ def main(argv=None):
     parser.add_argument("--grid", type=int, default=8, help="points per axis")
     parser.add_argument("--formulations", type=int, nargs="+", default=[0, 1], choices=[0, 1])
     parser.add_argument("--rtol", type=float, help="adaptive's rtol (atol = rtol / 100); default the FMU's")
+    parser.add_argument("--contact-law", default="linear", choices=["linear", "linear_along_normal"],
+                        help="the contact law (fixed axes: the conservative default, or the force along the normal)")
     parser.add_argument("--out", type=Path, default=ROOT / "out")
     parser.add_argument("--replot", action="store_true", help="redraw the figure from <out>/fig5_paper.csv only")
     args = parser.parse_args(argv)
@@ -232,13 +235,14 @@ def main(argv=None):
         return results
     # Compile or load the kernels here, so the workers' caps measure integration, not compilation.
     for formulation in args.formulations:
-        warm = Block("C", "adaptive", initial_state=2, A=0.3, omega=0.5, x_start=CREST, dt=DT, formulation=formulation)
+        warm = Block("C", "adaptive", initial_state=2, A=0.3, omega=0.5, x_start=CREST, dt=DT, formulation=formulation,
+                     contact_law=args.contact_law)
         warm.start(CREST / p["V_d"])
         warm.advance_to(CREST / p["V_d"] + 10.0)
         warm.outputs()
     omegas, amplitudes = np.geomspace(0.1, 1.0, args.grid), np.geomspace(0.3, 300.0, args.grid)
     # Faster plates cost more per tau_0: start them first, so the workers end together.
-    points = [(f, float(w), float(a), args.cap, rtol, args.cycles) for f in args.formulations
+    points = [(f, float(w), float(a), args.cap, rtol, args.cycles, args.contact_law) for f in args.formulations
               for w in omegas[::-1] for a in amplitudes]
     print(f"Fig. 5 at the paper's parameters (model C: k_d = {p['k_d']:g}, V_d = {p['V_d']:g}, A_x = {p['A_x']:g}, "
           f"omega_x = {p['omega_x']:g}, P_l = {p['P_l']:g}), adaptive (rtol = {rtol:g}, atol = {1e-2 * rtol:g}); "

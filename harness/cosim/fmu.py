@@ -47,11 +47,22 @@ class FmuError(RuntimeError):
     def __init__(self, call: str, status: int | None, log: Iterable[str], detail: str = ""):
         self.call, self.status, self.log = call, status, list(log)
         label = STATUS_LABELS[status] if status is not None and 0 <= status < len(STATUS_LABELS) else "failure"
-        text = f"{call} failed ({label})"
-        if detail:
-            text += f": {detail}"
-        if self.log:
-            text += "\nFMU log:\n  " + "\n  ".join(self.log)
+        # The FMU's own reasons (its error messages name the value, the rule and the fix)
+        # lead, after the FMI function's name only: a call that sets many values names the
+        # one the FMU refused in its message, not all it was given.
+        reasons = [line.split("] ", 1)[1] for line in self.log if line.startswith(("[error] ", "[fatal] "))]
+        function = call.split("(", 1)[0]
+        if reasons:
+            text = f"{function} refused: " + "; ".join(reasons)
+            others = [line for line in self.log if not line.startswith(("[error] ", "[fatal] "))]
+            if others:
+                text += "\nFMU log:\n  " + "\n  ".join(others)
+        else:
+            text = f"{call} failed ({label})"
+            if detail:
+                text += f": {detail}"
+            if self.log:
+                text += "\nFMU log:\n  " + "\n  ".join(self.log)
         super().__init__(text)
 
 

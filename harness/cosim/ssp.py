@@ -72,7 +72,7 @@ for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
 FMU_TYPE = "application/x-fmu-sharedlibrary"
 PLATE_CONNECTIONS = (("plate_z", "plate_z"), ("plate_v", "plate_v"), ("plate_a", "plate_a"))
-BLOCK_OUTPUTS = ("x", "z", "vx", "vz", "phi_integral", "slip_count", "contact", "normal_force")
+BLOCK_OUTPUTS = ("x", "z", "vx", "vz", "phi_integral", "coulomb_resets", "contact", "normal_force")
 
 
 class SspError(ValueError):

@@ -208,7 +208,7 @@ def plate_input(source, *, step_size: float | None = None, stop_time: float | No
 
 
 def simulate_block(fmu: str | os.PathLike, table: np.ndarray, *, start_values: dict | None = None,
-                   outputs=("x", "z", "vx", "vz", "phi_integral", "slip_count", "contact", "normal_force"),
+                   outputs=("x", "z", "vx", "vz", "phi_integral", "coulomb_resets", "contact", "normal_force"),
                    stop_time: float | None = None) -> np.ndarray:
     """Run a Block FMU in fmpy with the plate input ``table`` (:func:`plate_input`).
 

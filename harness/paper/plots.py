@@ -14,16 +14,28 @@ from typing import Callable, Mapping
 import numpy as np
 import xarray as xr
 
-from harness.runs.observables import FLYING, HOPPING, JAMMED, SLIDING, STICK_SLIP, STUCK
+from harness.runs.observables import FLYING, HOPPING, JAMMED, MICRO_SLIP, SLIDING, STICK_SLIP, STUCK
 
 REGIME_STYLE = {
     STICK_SLIP: {"marker": "s", "color": "tab:red", "label": "stick-slip"},
+    MICRO_SLIP: {"marker": "P", "color": "tab:pink", "label": "micro-slip (slides, short slips)"},
     SLIDING: {"marker": "o", "color": "tab:blue", "label": "sliding"},
     HOPPING: {"marker": "D", "color": "tab:orange", "label": "hopping (no rests, intermittent contact)"},
     STUCK: {"marker": "x", "color": "tab:gray", "label": "no slip in window"},
     JAMMED: {"marker": "v", "color": "tab:purple", "label": "jammed (self-locked)"},
     FLYING: {"marker": "^", "color": "tab:green", "label": "flying (no contact)"},
 }
+
+
+def axis_label(name: str) -> str:
+    """A parameter's name with its unit, from the FMUs' parameter table (model units:
+    delta_0, tau_0, m_0)."""
+    from vibroblock.parameters import COMMON_PARAMETERS
+
+    units = {p.name: p.unit for p in COMMON_PARAMETERS}
+    units.update({"A_x": "delta_0", "omega_x": "1/delta_0", "P_l": "m_0 delta_0/tau_0^2", "phi": "1"})
+    unit = units.get(name)
+    return f"{name} [{unit}]" if unit else name
 
 
 def _axes(ax):
@@ -61,11 +73,13 @@ def regime_grid(ax, omegas, amplitudes, regimes, onset, load_label: str, onset_l
 def plot_trajectories(runs: Mapping[str, xr.Dataset], ax=None, drive: bool = True):
     """x(t) of each run (label -> trajectory Dataset); the drive's V_d t as a dashed line."""
     ax = _axes(ax)
+    # A sliding block follows the drive within a few delta_0: the runs wide and pale
+    # underneath, the drive thin and dashed on top, so that neither hides the other.
     for label, ds in runs.items():
-        ax.plot(ds.time, ds.x, label=label)
+        ax.plot(ds.time, ds.x, lw=3.0, alpha=0.6, zorder=1, label=label)
     if drive and runs:
         first = next(iter(runs.values()))
-        ax.plot(first.time, first.attrs["V_d"] * first.time, "k--", lw=0.8, label="$V_d t$")
+        ax.plot(first.time, first.attrs["V_d"] * first.time, "k--", lw=0.8, zorder=3, label="drive $V_d t$")
     ax.set_xlabel(r"$t$ [$\tau_0$]")
     ax.set_ylabel(r"$x$ [$\delta_0$]")
     ax.legend()
@@ -90,8 +104,8 @@ def plot_phase_diagram(sweep: xr.Dataset, x: str = "omega", y: str = "A", ax=Non
         ax.plot(grid, load / grid**2, "k:", label=r"$A = g/\omega^2$")
     if onset is not None:
         ax.plot(grid, onset(grid), "k-", lw=1, label=onset_label)
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(axis_label(x))
+    ax.set_ylabel(axis_label(y))
     if log_y:
         ax.set_yscale("log")
     span = sweep[y].values
@@ -112,8 +126,8 @@ def plot_hysteresis(loops: Mapping[str, xr.Dataset], ax=None, log_phi: bool = Tr
             if part.sizes.get("step", 0):
                 ax.plot(part[parameter], part.phi, marker="s" if direction == "up" else "o", color=color,
                         markerfacecolor=fill, label=f"{label} ({direction})")
-        ax.set_xlabel(parameter)
-    ax.set_ylabel(r"$\phi$")
+        ax.set_xlabel(axis_label(parameter))
+    ax.set_ylabel(r"$\phi$ [1]")
     if log_phi:
         ax.set_yscale("log")
     ax.legend(fontsize="small")

@@ -86,6 +86,9 @@ IX, IZ, IVX, IVZ, IF, IPHI, IWORK, IDISS, IEN = range(9)
 # The three options, in the order of their integer codes.
 FORMULATIONS = ("fixed_axes", "tangent_frame")
 COULOMB_NORMALS = ("contact_force", "applied_load")
+# The contact law in fixed axes: the elastic force -grad(k_n delta^2 / 2), conservative on a
+# curved plate (0, the default), or k_n delta along the normal only (1; docs/physics.md, Sec. 3).
+CONTACT_LAWS = ("linear", "linear_along_normal")
 FLIGHTS = ("surface", "free")
 
 _COMMON = dict(m=1.0, k_n=1.0, k_t=0.28, gamma_n=0.07, gamma_t=2.5e-4, mu_s=0.5, A=0.0, omega=0.0)
@@ -145,6 +148,7 @@ class Trajectory:
     formulation: str = "fixed_axes"
     coulomb_normal: str = "contact_force"
     flight: str = "surface"
+    contact_law: str = "linear"
 
     def __getitem__(self, name):
         return self.states[name]
@@ -175,7 +179,7 @@ class Model:
     """Forces and switching functions of one variant in one formulation."""
 
     def __init__(self, model: str, parameters: dict, formulation="fixed_axes", coulomb_normal="contact_force",
-                 flight="surface"):
+                 flight="surface", contact_law="linear"):
         if model not in DEFAULTS:
             raise ValueError(f"unknown model {model!r}")
         unknown = set(parameters) - set(DEFAULTS[model])
@@ -186,6 +190,7 @@ class Model:
         self.formulation = option("formulation", formulation, FORMULATIONS)
         self.coulomb_normal = option("coulomb_normal", coulomb_normal, COULOMB_NORMALS)
         self.flight = option("flight", flight, FLIGHTS)
+        self.contact_law = option("contact_law", contact_law, CONTACT_LAWS)
         self.tangent = self.formulation == "tangent_frame"
         self.applied = self.coulomb_normal == "applied_load"
         self.free_flight = self.flight == "free"
@@ -264,13 +269,19 @@ class Model:
             load_x, load_z = p["P_l"] * sin_a, -p["P_l"] * cos_a
         else:
             load_x, load_z = 0.0, -p["m"] * p["g"]
-        fx = -p["k_d"] * (s[IX] - p["V_d"] * t) - normal * sin_a + tangential * cos_a + load_x
+        # The conservative contact's x-force k_n delta^2 tan(a) da/dx, da/dx = h'' cos^2(a).
+        curving = (p["k_n"] * delta * delta * sin_a * cos_a * self.curvature(s[IX])
+                   if touching and self.contact_law == "linear" else 0.0)
+        fx = -p["k_d"] * (s[IX] - p["V_d"] * t) - normal * sin_a + tangential * cos_a + load_x + curving
         fz = normal * cos_a + tangential * sin_a + load_z
         power_in = (p["k_d"] * (p["V_d"] * t - s[IX]) * p["V_d"] + plate_v * (normal * cos_a + tangential * sin_a)
                     + load_x * s[IVX] + load_z * s[IVZ])
         loss = p["gamma_t"] * u_t * u_t + (p["gamma_n"] * u_n * u_n if touching else 0.0)
+        # The contact's stored energy: d(k_n delta^2 / 2)/dt = -k_n delta u_n - curving vx for the
+        # conservative law; the old force's storage is booked as its power -k_n delta u_n.
+        storage = -p["k_n"] * delta * u_n - curving * s[IVX] if touching else 0.0
         return [s[IVX], s[IVZ], fx / p["m"], fz / p["m"], u_t if regime == LOADED else 0.0,
-                (s[IVX] - p["V_d"]) ** 2, power_in, loss, -p["k_n"] * delta * u_n if touching else 0.0]
+                (s[IVX] - p["V_d"]) ** 2, power_in, loss, storage]
 
     def _rhs_free_flight(self, t, s):
         """Fixed axes off contact with flight = 'free': m x'' = -k_d (x - V_d t) - gamma_t x',
@@ -454,12 +465,13 @@ def _first_switch(m: Model, regime, dense, t_old, t_new, samples):
 
 def simulate(model: str, parameters: dict | None = None, t_end: float = 100.0, sample_times=None,
              solver: Solver = Solver(), initial: int = 0, max_events: int = 10_000_000,
-             formulation="fixed_axes", coulomb_normal="contact_force", flight="surface", **start) -> Trajectory:
+             formulation="fixed_axes", coulomb_normal="contact_force", flight="surface", contact_law="linear",
+             **start) -> Trajectory:
     """Integrate from t = 0 to t_end; samples at ``sample_times`` (default: t_end only).
 
     ``formulation``, ``coulomb_normal`` and ``flight`` take the names in FORMULATIONS,
     COULOMB_NORMALS, FLIGHTS or their integer codes (docs/physics.md)."""
-    m = Model(model, dict(parameters or {}), formulation, coulomb_normal, flight)
+    m = Model(model, dict(parameters or {}), formulation, coulomb_normal, flight, contact_law)
     s = initial_state(m, initial, **start)
     start_state = s.copy()
     samples = np.atleast_1d(np.asarray(t_end if sample_times is None else sample_times, dtype=float))
@@ -553,7 +565,7 @@ def simulate(model: str, parameters: dict | None = None, t_end: float = 100.0, s
                                 for tk, row, c in zip(samples, data, states["contact"])])
     return Trajectory(model, m.p, samples, states, slips=slips, events=events, rhs_evaluations=evaluations,
                       wall_time=wall, event_log=log, initial=start_state, formulation=m.formulation,
-                      coulomb_normal=m.coulomb_normal, flight=m.flight)
+                      coulomb_normal=m.coulomb_normal, flight=m.flight, contact_law=m.contact_law)
 
 
 def stick_slip_cycle(parameters: dict) -> dict:

@@ -119,16 +119,19 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
         lines += [f"- {k}: {v}" for k, v in header.items()] + [""]
     lines += ["Verdicts are computed from the measured numbers by the criteria stated in each claim's module (`harness/paper/claims/`) "
               f"(relative tolerance {FORMULA_TOLERANCE:.0%} for formulas, {UNCHANGED_TOLERANCE:.0%} for 'unchanged', "
-              "bracket tests on the sweep grids). 'Friction' means regime stick_slip, stuck or jammed (held in the "
+              "bracket tests on the sweep grids). 'Friction' means regime stick_slip, micro_slip, stuck or jammed (held in the "
               "window); 'sliding' means following the drive (phi at most the threshold, drift >= V_d/2); 'hopping' large phi "
               "without rests and with contact less than half the window; 'flying' no contact. The rules are in "
               "`harness/runs/observables.py`.", "",
-              "| claim | statement | measured | verdict | why | figures |", "|---|---|---|---|---|---|"]
+              "The table keeps the numbers that decide each verdict; what was measured in full, why the verdict "
+              "follows and the settings are in \"Per claim\" below, and every figure has its caption under "
+              "\"Figures\".", "",
+              "| claim | statement | deciding numbers | verdict | figures |", "|---|---|---|---|---|"]
     summary = {}
     for row in rows:
         figures = " ".join(f"[{f}]({f})" for f in row.figures if f in figures_present)
-        lines.append(f"| {row.claim} | {_cell(CLAIM_TEXT[row.claim])} | {_cell(row.measured)} | **{row.verdict}** | "
-                     f"{_cell(row.reason)} | {figures} |")
+        lines.append(f"| {row.claim} | {_cell(_short(CLAIM_TEXT[row.claim]))} | "
+                     f"{_cell(_short(row.measured))} [details](#{_anchor(row.claim)}) | **{row.verdict}** | {figures} |")
         summary[row.verdict] = summary.get(row.verdict, 0) + 1
     lines += ["", "Summary: " + ", ".join(f"{v}: {n}" for v, n in sorted(summary.items()))]
     if reading_rows(studies):
@@ -155,9 +158,66 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
         lines += [f"| {name} | {t['wall_time']:.1f} s | {t.get('compute_time', 0.0):.1f} s | {t['source']} "
                   f"| {t['points_computed']} / {t['points_reused']} | {t['tasks_computed']} / {t['tasks_reused']} |"
                   for name, t in timed.items()]
+    lines += ["", "## Per claim", ""] + per_claim_markdown(rows, figures_present)
     if figures_present:
-        lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures_present]
+        lines += ["", "## Figures", ""]
+        for number, name in enumerate(figures_present, start=1):
+            lines += [f"![{name}]({name})", "", f"*Figure {number} ({name}): {figure_caption(name, rows)}*", ""]
     return "\n".join(lines) + "\n"
+
+
+# The table shows a cell's first clauses up to this many characters; the full text is in
+# the claim's own section.
+TABLE_CELL = 220
+
+
+def _short(text: str, limit: int = TABLE_CELL) -> str:
+    """The first clauses of ``text`` that fit in ``limit`` characters (cut at "; " or ". ")."""
+    text = " ".join(str(text).split())
+    if len(text) <= limit:
+        return text
+    cut = max(text.rfind("; ", 0, limit), text.rfind(". ", 0, limit))
+    return (text[:cut] if cut > limit // 3 else text[:limit].rsplit(" ", 1)[0]) + " ... (see below)"
+
+
+def _anchor(part: str) -> str:
+    return f"claim-{part.lower()}"
+
+
+def per_claim_markdown(rows: Sequence[Row], figures_present: Sequence[str]) -> list[str]:
+    """One section per claim part: statement, measured, verdict and why, settings, figures.
+    A measurement shared with the part before it is named, not repeated."""
+    lines, previous = [], None
+    for row in rows:
+        lines += [f'<a id="{_anchor(row.claim)}"></a>', f"### {row.claim}: {row.verdict}", "",
+                  f"*Claim:* {CLAIM_TEXT[row.claim]}", ""]
+        if previous is not None and row.measured == previous.measured:
+            lines += [f"*Measured:* the same runs and numbers as {previous.claim} (above).", ""]
+        else:
+            lines += [f"*Measured:* {row.measured}", ""]
+            previous = row
+        lines += [f"*Why {row.verdict}:* {row.reason}", ""]
+        if row.settings:
+            lines += [f"*Settings:* {row.settings}", ""]
+        shown = [f for f in row.figures if f in figures_present]
+        if shown:
+            lines += ["*Figures:* " + ", ".join(f"[{f}]({f}) (Figure {list(figures_present).index(f) + 1})"
+                                               for f in shown), ""]
+    return lines
+
+
+def figure_caption(name: str, rows: Sequence[Row]) -> str:
+    """What a figure shows: the claim parts it stands for and their statements."""
+    parts = [row for row in rows if name in row.figures]
+    if not parts:
+        return "drawn by the main job beside the claims (see the section that links to it)."
+    statements = []
+    for row in parts:
+        text = _short(CLAIM_TEXT[row.claim], 160).replace(" ... (see below)", " ...")
+        if text not in statements:
+            statements.append(text)
+    return (f"evidence for {', '.join(row.claim for row in parts)} -- " + "; ".join(statements)
+            + " Lengths in delta_0 = m g / k_n, times in tau_0 = sqrt(m / k_n), frequencies in 1/tau_0.")
 
 
 def make_figures(studies: dict[str, Study], out: str | os.PathLike) -> list[str]:

@@ -1,4 +1,4 @@
-"""Command line: ``vibroblock run | sweep | continuation`` (also ``python -m harness``).
+"""Command line: ``vibroblock run | sweep | continuation | record`` (also ``python -m harness``).
 
 Examples::
 
@@ -7,6 +7,7 @@ Examples::
     vibroblock sweep --grid k_n=0.5:4:6 --grid ratio=10,20 --derive gamma_n=k_n/ratio --model C
     vibroblock sweep --grid-file grid.toml --scheduler tcp://127.0.0.1:8786
     vibroblock continuation --parameter omega --values 0.3:1.2:10 --set A=2 --out out/loop.nc
+    vibroblock record station.mseed --inventory station.xml --peak-g 0.8 --time-stretch 200
 
 Every command prints its result (observables, or a summary) as JSON on the last line
 of standard output.  Model A starts from the ``scaled`` preset, B and C from the FMU's
@@ -21,8 +22,15 @@ import math
 import sys
 from pathlib import Path
 
-from .settings import (PRESETS, InitialCondition, Integration, ObservableSettings, Parameters, PointSettings,
-                       RunSettings, default_fmu)
+from .settings import (PRESETS, RESERVED_PARAMETERS, InitialCondition, Integration, ObservableSettings, Parameters,
+                       PointSettings, RunSettings, default_fmu)
+from vibroblock.parameters import DEFAULT_INTEGRATOR
+
+# The switches that set the FMU parameters --set does not (RESERVED_PARAMETERS).
+OWN_SWITCHES = {"dt": "--dt", "integrator": "--integrator", "initial_state": "--initial-state",
+                "x_start": "--x-start", "z_start": "--z-start", "vx_start": "--vx-start", "vz_start": "--vz-start"}
+# What --out writes, by suffix.
+OUT_SUFFIXES = {".nc": "NetCDF", ".zarr": "Zarr", ".csv": "a table of the data, without the settings"}
 
 
 def _models() -> list[str]:
@@ -73,32 +81,47 @@ def _limit(text: str) -> tuple[str, float]:
 
 def _resolve_choices(fmu: str, assignments: list) -> dict:
     """The --set values with choice names (formulation=tangent_frame) replaced by their
-    codes, read from the FMU's description of that Integer parameter."""
+    codes, read from the FMU's description of that Integer parameter.  A value that has a
+    switch of its own (dt, integrator, the initial condition) is refused with that switch."""
+    for name, value in assignments:
+        if name in RESERVED_PARAMETERS:
+            text = f"{value:g}" if isinstance(value, float) else str(value)
+            raise ValueError(f"--set {name}={text}: {name} is not a model parameter and is not set with --set; "
+                             f"use {OWN_SWITCHES[name]} {text}")
     named = {name: value for name, value in assignments if isinstance(value, str)}
     values = dict(assignments)
     if not named:
         return values
-    from harness.cosim.fmu import FmuInterface
-    try:
-        interface = FmuInterface(Path(fmu))
-    except Exception as exc:  # no FMU there: say what could not be resolved
-        raise SystemExit(f"--set {', '.join(f'{k}={v}' for k, v in named.items())}: cannot read the FMU {fmu} "
-                         f"to resolve the names ({exc})") from None
+    from harness.cosim.fmu import FmuInterface, extract_fmu
+    from harness.user_errors import require_fmu
+    interface = FmuInterface(extract_fmu(require_fmu(fmu)))
     for name, value in named.items():
         variable = interface.variables.get(name)
         if variable is None:
-            raise SystemExit(f"--set {name}={value}: {interface.model_name} has no parameter {name!r}")
+            raise ValueError(f"--set {name}={value}: {interface.model_name} has no parameter {name!r}; its "
+                             f"parameters are {', '.join(sorted(interface.parameters))}")
         try:
             values[name] = variable.typed(value)
         except ValueError as exc:
-            raise SystemExit(f"--set {name}={value}: {exc}") from None
+            raise ValueError(f"--set {name}={value}: {exc}") from None
     return values
+
+
+def _check_out(text: str | None) -> None:
+    """--out: a file name whose suffix says what to write (OUT_SUFFIXES), checked before the run."""
+    if text is None:
+        return
+    suffix = Path(text).suffix
+    if suffix not in OUT_SUFFIXES:
+        raise ValueError(f"--out {text}: the suffix {suffix or '(none)'!r} is not one this command writes; end the "
+                         "name in " + ", ".join(f"{s} ({kind})" for s, kind in OUT_SUFFIXES.items()))
 
 
 def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_help: str = "run length") -> None:
     group = parser.add_argument_group("model and run")
     group.add_argument("--model", default="A", choices=_models(), help="FMU of this model (default A)")
-    group.add_argument("--fmu", help="FMU file (overrides --model)")
+    group.add_argument("--fmu", help="FMU file (overrides --model; default build/fmus/Block<model>.fmu, "
+                                     "built by 'make fmus')")
     group.add_argument("--preset", default=None, choices=sorted(PRESETS),
                        help="starting parameter set (default: scaled for model A -- k_d = V_d = 1e-2, "
                             "gamma_t = 5e-3 -- and the FMU's own (paper) values for B and C)")
@@ -106,10 +129,15 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
                        metavar="NAME=VALUE", help="model parameter (repeatable): a number, true/false for a Boolean, "
                        "or an Integer's value by name, e.g. formulation=tangent_frame")
     group.add_argument("--horizon", type=float, default=horizon, help=f"{horizon_help} (default {horizon:g})")
-    group.add_argument("--interval", type=float, default=1.0, help="output interval = communication step")
-    group.add_argument("--integrator", default="symplectic_euler", choices=_choices("integrator"),
-                       help="internal integrator, as the FMU names it (default symplectic_euler)")
-    group.add_argument("--dt", type=float, default=4e-4, help="internal step (default 4e-4)")
+    group.add_argument("--interval", type=float, default=1.0,
+                       help="output interval = communication step, in tau_0 (default 1)")
+    group.add_argument("--integrator", default=DEFAULT_INTEGRATOR, choices=_choices("integrator"),
+                       help=f"internal integrator, as the FMU names it (default {DEFAULT_INTEGRATOR}, the FMUs' own "
+                            "default and the recommended one: exact flows on model A, error-controlled steps on B "
+                            "and C; symplectic_euler is the paper's first-order scheme)")
+    group.add_argument("--dt", type=float, default=4e-4,
+                       help="internal step of the fixed-step integrators, the output grid of adaptive and "
+                            "event_driven, in tau_0 (default 4e-4)")
     group.add_argument("--switch", action="append", default=[], type=_limit, metavar="NAME=LIMIT",
                        help="with --integrator-above (repeatable): a run in which NAME (a parameter, or "
                             "plate_speed = A omega) exceeds LIMIT uses --integrator-above instead of --integrator, "
@@ -125,9 +153,13 @@ def _add_run_options(parser: argparse.ArgumentParser, horizon: float, horizon_he
                            help=f"the FMU's {name} (where the initial state uses it)")
     group = parser.add_argument_group("observables")
     group.add_argument("--transient", type=float, default=None,
-                       help="discarded start of the run (of each ramp step) (default: a fifth of it)")
-    group.add_argument("--window", type=float, default=None, help="measuring window (default: rest of the run)")
-    group.add_argument("--phi-threshold", type=float, default=ObservableSettings.phi_threshold)
+                       help="discarded start of the run (of each ramp step), in tau_0 (default: a fifth of it)")
+    group.add_argument("--window", type=float, default=None,
+                       help="measuring window at the end of the run, in tau_0 (default: all after the transient)")
+    group.add_argument("--phi-threshold", type=float, default=ObservableSettings.phi_threshold,
+                       help="phi = <(vx - V_d)^2>/V_d^2 above which the block is held by friction (stick_slip or "
+                            f"hopping), below which it slides or is stuck (default {ObservableSettings.phi_threshold:g};"
+                            " harness.runs.observables)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
 
 
@@ -155,6 +187,8 @@ def command_run(args) -> int:
     from .run import simulate
 
     point = _point(args)
+    from harness.user_errors import require_fmu
+    require_fmu(point.run.fmu)
     ds = simulate(point.run, progress=not args.no_progress)
     result = observe(ds, point.observe).as_dict()
     if args.out:
@@ -220,6 +254,19 @@ def command_continuation(args) -> int:
     return 0
 
 
+def command_record(args) -> int:
+    from harness.ground.record_run import run_record, settings_from
+
+    outcome = run_record(settings_from(args))
+    result = outcome["result"]
+    _print_result({"figure": str(outcome["figure"]), "stop_time": outcome["stop_time"],
+                   "record_duration": outcome["duration_tau0"], "notes": outcome["notes"],
+                   "coulomb_resets": int(result["coulomb_resets"][-1]),
+                   "contact_fraction": float(result["contact"].mean()),
+                   "x_advance": float(result["x"][-1] - result["x"][0])})
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="vibroblock",
                                      description="Runs, sweeps and continuation on the vibroblock FMUs.",
@@ -229,7 +276,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = commands.add_parser("run", help="one run: trajectories and observables")
     _add_run_options(run, 20_000.0)
-    run.add_argument("--out", help="write the trajectories (.nc or .zarr)")
+    run.add_argument("--out", help="write the trajectories: .nc (NetCDF), .zarr or .csv")
     run.set_defaults(handler=command_run)
 
     sweep = commands.add_parser("sweep", help="observables over a parameter grid (Dask, resumable)")
@@ -242,7 +289,7 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--store", help="folder of finished points: a rerun computes only missing ones")
     sweep.add_argument("--scheduler", help="address of a running Dask scheduler, or 'inline' (no Dask)")
     sweep.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
-    sweep.add_argument("--out", help="write the sweep Dataset (.nc or .zarr)")
+    sweep.add_argument("--out", help="write the sweep Dataset: .nc (NetCDF), .zarr or .csv")
     sweep.set_defaults(handler=command_sweep)
 
     ramp = commands.add_parser("continuation", help="quasi-static ramp up then down (hysteresis)")
@@ -251,8 +298,13 @@ def build_parser() -> argparse.ArgumentParser:
     ramp.add_argument("--values", required=True, help="up-ramp values: start:stop:n or v1,v2,...")
     ramp.add_argument("--one-way", action="store_true", help="up only, no way back")
     ramp.add_argument("--fresh", action="store_true", help="also evaluate each value from a fresh start")
-    ramp.add_argument("--out", help="write the per-step Dataset (.nc or .zarr)")
+    ramp.add_argument("--out", help="write the per-step Dataset: .nc (NetCDF), .zarr or .csv")
     ramp.set_defaults(handler=command_continuation)
+
+    from harness.ground.record_run import add_arguments
+    record = commands.add_parser("record", help="a block on a plate moving like the ground in a seismic record")
+    add_arguments(record)
+    record.set_defaults(handler=command_record)
     return parser
 
 
@@ -260,15 +312,14 @@ def main(argv: list[str] | None = None) -> int:
     """Run one command; a bad record, bad settings or a refused FMU call end it with a
     one-line message on standard error and exit status 2, not a traceback."""
     args = build_parser().parse_args(argv)
-    from harness.cosim.fmu import FmuError
-    from harness.ground.records.errors import RecordError
-    try:
+    from harness.user_errors import run_main
+
+    def handle():
+        if args.command != "record":  # record's --out is a folder
+            _check_out(getattr(args, "out", None))
         return args.handler(args)
-    except (RecordError, FmuError, ValueError, KeyError, TypeError, OSError) as exc:
-        message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
-        one_line = "; ".join(line.strip() for line in message.splitlines() if line.strip()) or type(exc).__name__
-        print(f"vibroblock {args.command}: error: {one_line}", file=sys.stderr)
-        return 2
+
+    return run_main(f"vibroblock {args.command}", handle)
 
 
 if __name__ == "__main__":

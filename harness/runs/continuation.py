@@ -35,7 +35,7 @@ import numpy as np
 import xarray as xr
 
 from harness.cosim.fmu import InstancePool
-from .observables import MEASURED, STICK_SLIP, observe
+from .observables import MEASURED, PHI_STICK_SLIP, observe
 from .run import POINT_OUTPUTS, Recorder, open_instance, resolved_parameters, run_attributes, run_point, \
     trajectory_dataset
 from .settings import PointSettings, canonical_json, to_jsonable
@@ -149,7 +149,7 @@ def _columns(records: list[dict], dims: tuple[str, ...]) -> dict:
     for name in MEASURED:
         column = [r[name] for r in records]
         data[name] = (dims, np.array(column, dtype=str) if isinstance(column[0], str) else np.array(column))
-    data["stick_slip"] = (dims, np.array([r["regime"] == STICK_SLIP for r in records]))
+    data["stick_slip"] = (dims, np.array([r["regime"] in PHI_STICK_SLIP for r in records]))
     return data
 
 

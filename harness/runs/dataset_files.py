@@ -1,6 +1,7 @@
 """Writing and reading result Datasets.
 
-``.zarr`` folders are written with zarr; any other name as NetCDF, through h5netcdf
+``.zarr`` folders are written with zarr, ``.csv`` files as a table of the data (without
+the attributes); any other name as NetCDF, through h5netcdf
 (NetCDF-4) when h5py is installed, else through scipy (NetCDF-3, where 64-bit
 integers are stored as 32-bit: counts in this harness stay far below 2**31).
 Files are written to a temporary name and renamed, so a reader never sees half a file.
@@ -33,6 +34,11 @@ def save_dataset(ds: xr.Dataset, path: str | os.PathLike) -> Path:
             ds.to_zarr(staging, mode="w", consolidated=False)
         if path.exists():
             shutil.rmtree(path)
+        os.replace(staging, path)
+    elif path.suffix == ".csv":
+        # The data as a table (one row per time or grid point); the settings, which are
+        # the Dataset's attributes, travel in .nc and .zarr only.
+        ds.to_dataframe().to_csv(staging)
         os.replace(staging, path)
     else:
         ds.to_netcdf(staging, engine=netcdf_engine())

@@ -1,7 +1,7 @@
 """Observables of a run: pure functions of its trajectory Dataset.
 
 Every function takes a Dataset as :func:`harness.runs.run.simulate` returns it (variables
-``x``, ``vx``, optionally ``phi_integral``, ``contact``, ``slip_count`` over ``time``;
+``x``, ``vx``, optionally ``phi_integral``, ``contact``, ``coulomb_resets`` over ``time``;
 the drive velocity ``V_d`` and the other parameters as attributes) and a measuring
 window; :func:`observe` computes them all under one :class:`ObservableSettings`
 and returns an :class:`Observables` record that states its window, transient and
@@ -10,6 +10,26 @@ threshold.
 Window: [t_from, t_to] with t_to the last sample and t_from = max(start + transient,
 t_to - window) (window None: start + transient), snapped to the first sample at or
 after it.
+
+Vocabulary (one meaning each)
+-----------------------------
+* A **Coulomb reset** is one break of the tangential (Cundall-Strack) spring, when
+  |k_t F| reaches mu_s N: the FMUs count them in their output ``coulomb_resets`` (old
+  name ``slip_count``), and ``coulomb_resets`` here is their number in the window.
+* A **slip** is a stretch of motion: the block moves faster than the drive.  The one rule
+  that turns the motion (and with it the many resets it holds: the spring rings after a
+  break and breaks again) into slips is :func:`slip_events`: a run of samples with
+  vx > ``slip_release`` V_d that reaches vx > ``slip_onset`` V_d; runs at most
+  ``merge_gap`` apart are one slip; it counts when it advanced x by at least
+  ``slip_min_length`` (default a quarter of the paper's slip length mu_s N0 / k_d).
+  ``slip_events`` is their number in the window; shorter slips count as none.
+* The **regime** names what the block does in the window and never contradicts those
+  counts: ``stick_slip`` has slips (or a window shorter than one cycle, with the block
+  resting); a block whose phi is above the threshold while it never rests, drifts with
+  the drive and makes no slip of the counted size is ``micro_slip`` (it slides, with
+  short slips, e.g. one per plate period where the Coulomb bound dips at each trough of
+  N).  Both are held by friction in the paper's sense (phi above the threshold): a
+  sweep's Boolean ``stick_slip`` is true for both.
 
 Definitions
 -----------
@@ -20,7 +40,9 @@ Definitions
   "flying" if it never touches the plate (no contact sample); "hopping" if
   phi > threshold but the block touches the plate less than half of the window and
   rests less than a tenth of it (it hops from landing to landing, e.g. from crest to
-  crest of a corrugation: not held by friction, however large phi); "stick_slip" if
+  crest of a corrugation: not held by friction, however large phi); "micro_slip" if
+  phi > threshold but the block rests less than a tenth of the window, drifts with the
+  drive (>= half of V_d) and no slip of the counted size completes in it; "stick_slip" if
   phi > threshold otherwise; "sliding" if it keeps up with the drive
   (drift velocity >= half of V_d); "jammed" if it neither slips nor keeps up while the
   drive spring's stretch V_d t - x grows and ends beyond the flat surface's Coulomb
@@ -68,7 +90,11 @@ import xarray as xr
 from .settings import ObservableSettings
 
 STICK_SLIP, SLIDING, HOPPING, STUCK, JAMMED, FLYING = "stick_slip", "sliding", "hopping", "stuck", "jammed", "flying"
-REGIMES = (STICK_SLIP, SLIDING, HOPPING, STUCK, JAMMED, FLYING)
+MICRO_SLIP = "micro_slip"
+REGIMES = (STICK_SLIP, MICRO_SLIP, SLIDING, HOPPING, STUCK, JAMMED, FLYING)
+# The regimes with phi above the threshold while the block is held (the paper's stick-slip
+# criterion): a sweep's Boolean ``stick_slip``.
+PHI_STICK_SLIP = (STICK_SLIP, MICRO_SLIP)
 # A block drifting slower than this share of V_d over a window without slips is stuck.
 STUCK_DRIFT_FRACTION = 0.5
 # At rest: |vx| below this share of V_d (the creep of a stick, V_d k_d / (k_t + k_d), is
@@ -147,12 +173,18 @@ def classify(phi_value: float, threshold: float, drift: float = math.nan, v_d: f
     return SLIDING
 
 
-def refine(regime: str, ds: xr.Dataset, win: Window, contact: float) -> str:
-    """The rules that need the trajectory: flying (no contact in the window) and jammed
-    (stuck with the drive spring's stretch growing beyond the flat surface's Coulomb
-    limit); see the module doc."""
+def refine(regime: str, ds: xr.Dataset, win: Window, contact: float, slips: int | None = None,
+           rests: float = math.nan, drift: float = math.nan) -> str:
+    """The rules that need the trajectory: flying (no contact in the window), micro_slip
+    (phi above the threshold without a counted slip, never at rest, drifting with the
+    drive: ``slips`` completed slips, ``rests`` the rest fraction, ``drift`` the drift
+    velocity) and jammed (stuck with the drive spring's stretch growing beyond the flat
+    surface's Coulomb limit); see the module doc."""
     if contact == 0.0:
         return FLYING
+    if (regime == STICK_SLIP and slips == 0 and rests < STICK_REST_FRACTION
+            and drift >= STUCK_DRIFT_FRACTION * abs(drive_velocity(ds))):
+        return MICRO_SLIP
     if regime != STUCK:
         return regime
     v_d = drive_velocity(ds)
@@ -193,9 +225,12 @@ def contact_fraction(ds: xr.Dataset, win: Window) -> float:
 
 
 def coulomb_resets(ds: xr.Dataset, win: Window) -> int:
-    if "slip_count" not in ds:
+    """Coulomb resets in the window (-1: not recorded); ``slip_count`` is the FMUs' old
+    name of the same output."""
+    name = next((n for n in ("coulomb_resets", "slip_count") if n in ds), None)
+    if name is None:
         return -1
-    counts = ds["slip_count"].values
+    counts = ds[name].values
     return int(counts[win.last] - counts[win.first])
 
 
@@ -295,7 +330,7 @@ class Observables:
 
     phi: float
     regime: str
-    slip_events: int  # slips seen in the motion (not the FMU's slip_count, which counts Coulomb resets)
+    slip_events: int  # slips in the motion, by slip_events' rule (the module doc's vocabulary)
     stick_time_mean: float
     stick_time_std: float
     slip_interval_mean: float
@@ -304,7 +339,7 @@ class Observables:
     contact_fraction: float
     rest_fraction: float        # share of the window at rest (see the module doc)
     drift_velocity: float
-    coulomb_resets: int
+    coulomb_resets: int         # breaks of the friction spring (the FMUs' coulomb_resets) in the window
     slope_angle_end: float      # degrees, corrugated plates only (see the module doc)
     slope_angle_at_rest: float  # degrees, median over the samples at rest
     window_start: float
@@ -314,7 +349,8 @@ class Observables:
 
     @property
     def stick_slip(self) -> bool:
-        return self.regime == STICK_SLIP
+        """phi above the threshold while held: stick_slip or micro_slip (the paper's criterion)."""
+        return self.regime in PHI_STICK_SLIP
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -335,7 +371,7 @@ def observe(ds: xr.Dataset, settings: ObservableSettings = ObservableSettings())
     contact = contact_fraction(ds, win)
     rests = rest_fraction(ds, win)
     regime = refine(classify(value, settings.phi_threshold, drift, drive_velocity(ds), rests, contact), ds, win,
-                    contact)
+                    contact, slips.count, rests, drift)
     angle_end, angle_at_rest = slope_angles(ds, win)
     return Observables(
         phi=value, regime=regime, slip_events=slips.count,

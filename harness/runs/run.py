@@ -28,7 +28,7 @@ from .observables import Observables, observe
 from .settings import PointSettings, RunSettings, canonical_json
 
 # What the observables read; recording only these keeps a sweep point cheap.
-POINT_OUTPUTS = ("x", "vx", "phi_integral", "contact", "slip_count")
+POINT_OUTPUTS = ("x", "vx", "phi_integral", "contact", "coulomb_resets")
 # Rows between progress-bar updates (a bar update costs more than an FMU step).
 PROGRESS_CHUNK = 500
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from harness.cosim.fmu import REPO_ROOT
+from vibroblock.parameters import DEFAULT_INTEGRATOR
 
 # Parameter sets a run can start from.  "scaled" keeps model A quasi-static while making a
 # stick-slip cycle affordable: stick ~5.2e3 tau_0, slip ~50 delta_0 (see docs/claims.md, Conventions).
@@ -117,9 +118,13 @@ class Integration:
     fixed-step schemes on the contact's period), so a sweep can run each point with the
     cheaper one.  The choice is made per run (:meth:`RunSettings.integrator_for`) and
     recorded with its results.
+
+    The default integrator is the FMUs' own, ``adaptive`` (``vibroblock.parameters.DEFAULT_INTEGRATOR``:
+    event_driven's exact flows on model A, error-controlled steps on B and C); the paper's
+    scheme is ``Integration("symplectic_euler")``.
     """
 
-    integrator: str = "symplectic_euler"
+    integrator: str = DEFAULT_INTEGRATOR
     dt: float = 4e-4
     switch: tuple = ()
     integrator_above: str | None = None
@@ -214,7 +219,10 @@ class RunSettings:
             object.__setattr__(self, "parameters", Parameters(self.parameters))
         reserved = sorted(RESERVED_PARAMETERS & set(self.parameters))
         if reserved:
-            raise ValueError(f"{', '.join(reserved)} belong to Integration / InitialCondition, not to parameters")
+            owners = {name: "Integration(dt=...)" if name == "dt" else "Integration(integrator=...)"
+                      if name == "integrator" else f"InitialCondition({name}=...)" for name in reserved}
+            raise ValueError("; ".join(f"{name} = {self.parameters[name]:g} is not a model parameter: give it as "
+                                       f"{owner}" for name, owner in owners.items()))
         for name in ("horizon", "output_interval"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):

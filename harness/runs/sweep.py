@@ -59,7 +59,7 @@ import numpy as np
 import xarray as xr
 
 from harness.cosim.fmu import DEFAULT_CACHE, REPO_ROOT, FmuInterface, InstancePool, fmu_sha256
-from .observables import MEASURED, STICK_SLIP
+from .observables import MEASURED, PHI_STICK_SLIP
 from .run import run_point
 from .settings import PointSettings, canonical_json, to_jsonable
 from .store import PointStore, point_key
@@ -530,7 +530,7 @@ def assemble(grid: Grid, points: Sequence[GridPoint], results: Mapping[str, dict
             derived[name][point.index] = point.derived[name]
     data = {name: (dims, values.astype(str) if values.dtype == object else values)
             for name, values in columns.items()}
-    data["stick_slip"] = (dims, columns["regime"].astype(str) == STICK_SLIP)
+    data["stick_slip"] = (dims, np.isin(columns["regime"].astype(str), PHI_STICK_SLIP))
     coords = {a.name: (a.name, np.array(a.values)) for a in grid.axes}
     coords.update({name: (dims, values) for name, values in derived.items()})
     defaults = interface.defaults()

@@ -22,7 +22,7 @@ def test_record_response_from_a_two_column_file(fmu_path, tmp_path):
     acc = np.exp(-((t - 8.0) / 1.5) ** 2) * np.sin(2 * np.pi * 3.0 * t)  # m/s^2, a 3 Hz burst
     record = tmp_path / "burst.csv"
     np.savetxt(record, np.column_stack([t, acc]), delimiter=",", header="time,acceleration")
-    out = example("record_response").run_experiment(record, fmu=fmu_path("A"), out_dir=tmp_path,
+    out = example("record_response").run_experiment(record, fmu=fmu_path("A"), out_dir=str(tmp_path),
                                                     quantity="acceleration", unit="m/s^2", peak_g=1.3,
                                                     step_size=0.5)
     assert out["figure"].is_file()

@@ -13,6 +13,7 @@ from fmpy.validation import validate_fmu
 
 from fmu_testing import do_step, fmu_log, set_real, status_of  # noqa: F401 (fixture)
 from vibroblock import Block
+from vibroblock.parameters import DEFAULT_INTEGRATOR
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
 OUTPUTS = ["x", "z", "vx", "vz", "friction_force", "normal_force", "phi_integral", "penetration", "surface_z"]
@@ -26,6 +27,9 @@ def extracted(fmu_path, tmp_path_factory):
 
 @contextlib.contextmanager
 def instance(extracted, model, log, start_values=None, name="block"):
+    # These checks were written for the paper's fixed-step scheme (bit-for-bit splits, dt
+    # limits, the blow-up guard); the FMUs default to adaptive since, so they ask for it.
+    start_values = {"integrator": 0, **(start_values or {})}
     md, unzipdir = extracted[model]
     slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
                       instanceName=name)
@@ -72,18 +76,23 @@ def test_fmpy_validation_reports_nothing(fmu_path, model):
 
 
 @pytest.mark.parametrize("model", "ABC")
-def test_simulate_fmu_equals_the_core(fmu_path, model):
+@pytest.mark.parametrize("integrator", [None, 0])
+def test_simulate_fmu_equals_the_core(fmu_path, model, integrator):
+    """With the FMU's default integrator (adaptive, which the master does not set) and with
+    the paper's scheme (0, set)."""
     settings = dict(SCALED, A=0.5, omega=0.9)
+    chosen = {} if integrator is None else {"integrator": integrator}
     result = simulate_fmu(fmu_path(model), stop_time=200.0, output_interval=0.5,
-                          start_values={**settings, "initial_state": 2})
-    block = Block(model, initial_state=2, **settings)
+                          start_values={**settings, "initial_state": 2, **chosen})
+    block = Block(model, DEFAULT_INTEGRATOR if integrator is None else integrator, initial_state=2, **settings)
     block.start()
     expected = [block.outputs()]
     for t in result["time"][1:]:
         block.advance_to(t)
         expected.append(block.outputs())
-    for name in OUTPUTS + ["contact", "slip_count"]:
+    for name in OUTPUTS + ["contact", "coulomb_resets", "slip_count"]:
         np.testing.assert_array_equal(result[name], [row[name] for row in expected], err_msg=name)
+    np.testing.assert_array_equal(result["slip_count"], result["coulomb_resets"])  # the old name, one release
 
 
 COST_OUTPUTS = {"accepted_steps": "accepted", "rejected_steps": "rejected", "located_events": "events",
@@ -159,8 +168,19 @@ def test_block_a_takes_exact_flows_with_adaptive_unless_told_otherwise(fmu_path)
         assert abs(steps[name] - exact[name]) < 1e-8 * max(1.0, abs(exact[name])), name
 
 
+@pytest.mark.parametrize("model", "ABC")
+def test_the_default_integrator_is_adaptive_and_says_so(fmu_path, model):
+    md = read_model_description(fmu_path(model))
+    variable = next(v for v in md.modelVariables if v.name == "integrator")
+    assert variable.start == "4" and "default 4 = adaptive on every model" in variable.description
+    outputs = {v.name: v for v in md.modelVariables if v.causality == "output"}
+    assert outputs["coulomb_resets"].type == outputs["slip_count"].type == "Integer"
+    assert "old name of coulomb_resets" in outputs["slip_count"].description
+
+
 def test_communication_step_does_not_change_the_trajectory(fmu_path):
-    settings = {**SCALED, "A": 1.2, "omega": 1.1, "initial_state": 2}  # bouncing: chaotic, a strict check
+    # The fixed-step schemes' promise (their grid t0 + n dt); bouncing: chaotic, a strict check.
+    settings = {**SCALED, "A": 1.2, "omega": 1.1, "initial_state": 2, "integrator": 0}
     runs = {h: simulate_fmu(fmu_path("A"), stop_time=300.0, output_interval=h, start_values=settings)
             for h in (0.01, 0.75, 300.0)}
     for h in (0.01, 0.75):
@@ -434,6 +454,7 @@ def test_an_unstable_dt_is_refused_at_initialization(extracted, fmu_log):
     try:
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
+        slave.setInteger([vr["integrator"]], [0])  # the fixed-step scheme's stability limit (adaptive has none)
         slave.setReal([vr["k_n"]], [1e8])
         assert status_of(lambda: slave.fmi2ExitInitializationMode(slave.component)) == fmi2Error
         assert any("use dt <=" in message for *_, message in fmu_log.records)

@@ -329,10 +329,6 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
     load_x, load_z = load(kind, cos_m, sin_m, prm)
     force_n = -(drive + load_x) * sin_m + load_z * cos_m - m * plate_accel * cos_m
     force_t = (drive + load_x) * cos_m + load_z * sin_m - m * plate_accel * sin_m
-    if pen0 > 0.0 and sin_m != 0.0:  # a conservative contact's curvature term, held over the step like the load
-        curving = curvature_force(kind, x_mid, pen0, cos_m, sin_m, prm)
-        force_n -= curving * sin_m
-        force_t += curving * cos_m
     # Rate at which delta changes as the tangent line under the block turns
     # (d delta/dt = -u_n - delta tan(alpha) Omega), taken at the predicted midpoint.
     delta_rate = 0.0
@@ -354,6 +350,10 @@ def implicit_contact_step(kind, prm, x, z, vx, vz, shear, t, h, pz0, pv0, pz1, p
         else:
             pen_mid = pen0 + 0.5 * h * pen_rate0 - 0.125 * h * h * force_n / m
         delta_rate = -turning * pen_mid
+        if in_contact:  # a conservative contact's curvature term, at the midpoint like the other soft forces
+            curving = curvature_force(kind, x_mid, pen_mid, cos_m, sin_m, prm)
+            force_n -= curving * sin_m
+            force_t += curving * cos_m
 
     # -- normal direction: exact flow, contact switches located ---------------------
     d, v = pen0, delta_rate - u_n0  # delta and its rate

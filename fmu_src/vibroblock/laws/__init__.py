@@ -38,6 +38,8 @@ from types import ModuleType
 from .. import jitcache  # noqa: F401  (before numba: the kernel cache's folder and locator)
 from numba import njit  # noqa: E402
 
+from ..dispatch import by_kind  # noqa: E402
+
 
 @dataclass(frozen=True)
 class Axis:
@@ -114,26 +116,13 @@ def choices() -> dict[str, tuple[str, dict[int, str]]]:
 # ---------------------------------------------------------------- compiled dispatch
 def _dispatch(axis_name: str, function: str, arguments: str):
     """A compiled ``(kind, arguments) -> law(kind).function(arguments)``, branching on the
-    axis' bits of kind at run time (a run constant: the branch is perfectly predicted)."""
+    axis' bits of kind at run time (``vibroblock.dispatch``); a law that needs the variant
+    (e.g. the applied load's normal) takes kind itself."""
     axis, laws = AXES[axis_name], LAWS[axis_name]
-    namespace = {f"_{law.id}": getattr(law.module, function) for law in laws.values()}
-    ids = sorted(laws)
-    # (a law that needs the variant, e.g. the applied load's normal, takes kind itself)
-    passed = arguments if arguments.startswith("kind,") else f"kind, {arguments}"
-    lines = [f"def dispatch({passed}):"]
-    if len(ids) == 1:
-        lines.append(f"    return _{ids[0]}({arguments})")
-    else:
-        lines.append(f"    law = (kind >> {axis.shift}) & {(1 << axis.width) - 1}")
-        for i, k in enumerate(ids[:-1]):  # (one return: numba's inliner wants one)
-            lines.append(f"    {'if' if i == 0 else 'elif'} law == {k}:")
-            lines.append(f"        result = _{k}({arguments})")
-        lines.append("    else:")
-        lines.append(f"        result = _{ids[-1]}({arguments})")
-        lines.append("    return result")
-    exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registry's ids only
-    # Compiled on its own, small enough for LLVM to inline it where it is called.
-    return njit(namespace["dispatch"])
+    takes_kind = arguments.startswith("kind,")
+    return by_kind({law.id: getattr(law.module, function) for law in laws.values()},
+                   f"(kind >> {axis.shift}) & {(1 << axis.width) - 1}",
+                   arguments[len("kind, "):] if takes_kind else arguments, takes_kind)
 
 
 def _constant(axis_name: str, attribute: str):

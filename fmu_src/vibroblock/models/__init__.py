@@ -33,6 +33,7 @@ from .. import jitcache  # noqa: F401  (before numba: the kernel cache's folder 
 from numba import njit, types  # noqa: E402
 from numba.extending import overload  # noqa: E402
 
+from ..dispatch import by_kind  # noqa: E402
 from ..parameters import COMMON_PARAMETERS, OPTIONAL_COMMON, VARIANT_AFTER, Parameter  # noqa: E402
 from ..readings import VARIANT_MASK  # noqa: E402
 
@@ -139,23 +140,9 @@ def curvature(kind, x, prm):
 
 
 def _by_variant(attribute: str, arguments: str):
-    """A compiled function ``(kind, arguments) -> variant(kind).attribute(arguments)`` that
-    branches on the variant's index at run time: kind is a run constant, so the branch is
-    perfectly predicted, and one kernel serves every variant (one compilation, not one
-    per variant)."""
-    namespace = {f"_{v.kind}": getattr(v, attribute) for v in _BY_KIND.values()}
-    kinds = sorted(_BY_KIND)
-    lines = [f"def dispatch(kind, {arguments}):", f"    variant = kind & {VARIANT_MASK}"]
-    for i, k in enumerate(kinds[:-1]):  # (one return: numba inlines it into its callers)
-        lines.append(f"    {'if' if i == 0 else 'elif'} variant == {k}:")
-        lines.append(f"        result = _{k}({arguments})")
-    lines.append("    else:")
-    lines.append(f"        result = _{kinds[-1]}({arguments})")
-    lines.append("    return result")
-    exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registry's indices only
-    # Compiled on its own, not inlined at numba's level (whose inliner trips on the
-    # branches' shared result), and small enough for LLVM to inline it where it is called.
-    return njit(namespace["dispatch"])
+    """A compiled ``(kind, arguments) -> variant(kind).attribute(arguments)``, branching on
+    the variant's index at run time (``vibroblock.dispatch``)."""
+    return by_kind({v.kind: getattr(v, attribute) for v in _BY_KIND.values()}, f"kind & {VARIANT_MASK}", arguments)
 
 
 _PROFILE_BY_VARIANT = _by_variant("profile", "x, prm")

@@ -199,6 +199,7 @@ def read_record(
     trace_id: str | None = None,
     response: ResponseSettings | None = None,
     time_tolerance: float = 0.01,
+    sensitivity: float | None = None,
 ) -> Record:
     """Read one ground-motion channel and return it in SI units.
 
@@ -224,6 +225,11 @@ def read_record(
         time_tolerance: for two-column files, the largest allowed deviation
             of a time stamp from the uniform grid, as a fraction of the
             sample interval.
+        sensitivity: for seismic formats whose samples are counts (integers, as
+            a digitizer writes them): counts per *unit* of *quantity*, the
+            recording chain's overall sensitivity (flat response assumed).
+            Counts are refused with *quantity* and *unit* alone: declaring
+            counts to be m/s would make them physical by fiat.
 
     Returns:
         The :class:`Record`.
@@ -248,6 +254,14 @@ def read_record(
     q = parse_quantity(quantity) if quantity is not None else None
     if q is not None:
         si_factor(q, unit)  # validate early, before touching the file
+    if sensitivity is not None:
+        if q is None:
+            raise RecordError(f"sensitivity = {sensitivity!r} counts per unit needs quantity= and unit= (what one "
+                              "unit is, e.g. quantity='velocity', unit='m/s')")
+        if not (np.isfinite(sensitivity) and sensitivity > 0):
+            raise RecordError(f"sensitivity = {sensitivity!r} must be a finite number > 0 (counts per unit)")
+        if inventory is not None:
+            raise RecordError("give either an inventory (the full response) or a sensitivity (a flat one), not both")
 
     try:
         import obspy
@@ -256,7 +270,7 @@ def read_record(
     if isinstance(source, (obspy.Stream, obspy.Trace)):
         stream = obspy.Stream([source]) if isinstance(source, obspy.Trace) else source
         return _from_stream(stream.copy(), "<obspy stream>", q, unit, inventory,
-                            trace_id, response)
+                            trace_id, response, sensitivity)
 
     path = Path(source)
     if not path.is_file():
@@ -273,7 +287,7 @@ def read_record(
     if fmt in ("TWOCOLUMN", "CSV") or (not fmt and suffix in _TWO_COLUMN_SUFFIXES):
         return _read_two_column(path, q, unit, time_tolerance)
     stream = _obspy_read(path, fmt or None)
-    return _from_stream(stream, str(path), q, unit, inventory, trace_id, response)
+    return _from_stream(stream, str(path), q, unit, inventory, trace_id, response, sensitivity)
 
 
 # --------------------------------------------------------------------------- text
@@ -431,13 +445,26 @@ def _select_trace(stream: obspy.Stream, where: str, trace_id: str | None) -> obs
             "record to a gap-free segment or fill the gaps "
             "(e.g. Stream.merge(fill_value='interpolate')) first"
         )
+    # Integer samples are counts as a digitizer writes them (_is_counts); noted before they become floats.
+    tr.stats.integer_samples = bool(np.issubdtype(np.ma.getdata(tr.data).dtype, np.integer))
     tr.data = np.asarray(np.ma.getdata(tr.data), dtype=float)
     return tr
 
 
+def _is_counts(tr: obspy.Trace) -> bool:
+    """Samples as an instrument writes them, not ground motion: integers (MiniSEED's
+    integer encodings, GSE2's CM6, ...), or a SAC file whose header says its dependent
+    variable is volts (idep = 50), or unknown (idep = 5) with integral values."""
+    if tr.stats.get("integer_samples") or np.issubdtype(tr.data.dtype, np.integer):
+        return True
+    sac = getattr(tr.stats, "sac", None)
+    idep = None if sac is None else sac.get("idep")
+    return idep == 50 or (idep == 5 and bool(np.all(np.mod(tr.data, 1.0) == 0.0)))
+
+
 def _from_stream(stream: obspy.Stream, where: str, q: Quantity | None, unit: str | None,
                  inventory: obspy.Inventory | PathLike | None, trace_id: str | None,
-                 response: ResponseSettings) -> Record:
+                 response: ResponseSettings, sensitivity: float | None = None) -> Record:
     tr = _select_trace(stream, where, trace_id)
     if tr.stats.npts < MIN_SAMPLES:
         raise RecordError(
@@ -456,6 +483,17 @@ def _from_stream(stream: obspy.Stream, where: str, q: Quantity | None, unit: str
                 "given; pass units if the samples are already physical, an "
                 "inventory if they are counts, not both"
             )
+        if sensitivity is not None:
+            return Record(data=np.asarray(tr.data, dtype=float) / sensitivity * si_factor(q, unit), quantity=q,
+                          history=(read_note, f"counts divided by the stated sensitivity {sensitivity:g} counts per "
+                                              f"{unit} ({q.value}, flat response)"), **common)
+        if _is_counts(tr) and getattr(tr.stats, "response", None) is None:
+            raise RecordError(
+                f"{where}: the samples of {tr.id} are the instrument's output (counts or volts, as its header or "
+                f"integer samples say), so declaring them {q.value} in {unit} would not make them physical; give "
+                "the instrument response "
+                "(inventory: StationXML, RESP or dataless SEED; --inventory on the command line) or the "
+                f"recording chain's sensitivity in counts (or volts) per {unit} (--sensitivity)")
         return Record(data=tr.data * si_factor(q, unit), quantity=q,
                       history=(read_note, f"{q.value} in {unit} as stated by the caller"),
                       **common)
@@ -521,7 +559,8 @@ def _find_response(tr: obspy.Trace, where: str,
         return resp
     raise RecordError(
         f"{where}: {tr.id} has no instrument response and no stated units, so "
-        "its samples (usually counts) have no physical meaning; pass "
-        "inventory= (StationXML/RESP/dataless) to remove the response, or "
-        "quantity= and unit= if the samples are already physical"
+        "its samples (usually counts) have no physical meaning; give the "
+        "response (inventory=, --inventory: StationXML, RESP or dataless SEED) "
+        "or the sensitivity (sensitivity= with quantity= and unit=, --sensitivity "
+        "--quantity --unit), or quantity= and unit= if the samples are already physical"
     )

@@ -128,7 +128,7 @@ def draw(study: Study, save) -> None:
     located = [(c["omega"], c["located_A"]) for c in study.measured["columns"] if c.get("located_A") is not None]
     if located:
         ax.plot(*zip(*located), "D", color="k", mfc="none", label="boundary (bisected)")
-    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A", title="Model A (scaled drive)")
+    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$ [$\tau_0^{-1}$]", ylabel=r"$A$ [$\delta_0$]", title="Model A (scaled drive)")
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)
     ax.legend(fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.5))  # beside the grid, not over it
     save(fig, "fig1c_phase_diagram_A.png")

@@ -170,7 +170,7 @@ def draw(study: Study, save) -> None:
                         label=f"$\\gamma_n$ = {loop['gamma_n']:g} ({direction})")
         ax.axvline(float(bouncing_floor_omega(study.measured["amplitude"], gamma_n=loop["gamma_n"])), color=color,
                    ls=":", lw=0.8)
-    ax.set(yscale="log", xlabel=r"$\omega$", ylabel=r"$\phi$",
+    ax.set(yscale="log", xlabel=r"$\omega$ [$\tau_0^{-1}$]", ylabel=r"$\phi$ [1]",
            title=f"Model A, A = {study.measured['amplitude']:g}: ramp up then down (dotted: bouncing-ball floor)")
     ax.legend(fontsize="x-small", ncol=2)
     save(fig, "hysteresis_gamma_n.png")

@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from harness.runs.observables import PHI_STICK_SLIP
+
 from .measure import OBSERVE_B, OMEGA_X, SCALED, VALLEY, WAVELENGTH, b_point, observe_json, run_and_measure
 from .study import Claim, Runner, Study
 from .readings import READINGS
@@ -130,7 +132,7 @@ def verdict_c5(m: dict) -> tuple[Row, Row, Row]:
         row_b = Row("C5b", measured_b, AGREES if ok else DISAGREES,
                     f"median distance {'<=' if ok else '>'} {ROOT_TOLERANCE:g} wavelengths")
     measured_c = f"k_t = 0: regime {free['regime']}, {free['slip_events']} slips of {fmt(free['slip_length'])}"
-    if free["regime"] == "stick_slip":
+    if free["regime"] in PHI_STICK_SLIP:
         row_c = Row("C5c", measured_c, AGREES, "stick-slip without tangential spring")
     elif free["regime"] == "stuck":
         row_c = Row("C5c", measured_c, NOT_REPRODUCED, "no slip in the window (stuck): window shorter than a stick")
@@ -184,7 +186,7 @@ def draw_fig4(study: Study, save) -> None:
         ax.plot(stable, np.cos(omega_x * np.asarray(stable)), "o", color=color, ms=6)
         ax.plot(unstable, np.cos(omega_x * np.asarray(unstable)), "o", color=color, mfc="none", ms=6)
         ax.axvline(x, color=color, lw=2, alpha=0.5)
-    ax.set(xlabel="x", ylabel="", title="Eq. (9), model B, $k_t$ = 0 (scaled drive): roots filled = stable, "
+    ax.set(xlabel=r"$x$ [$\delta_0$]", ylabel="", title="Eq. (9), model B, $k_t$ = 0 (scaled drive): roots filled = stable, "
            "open = unstable;\nvertical bars: the simulated block at the first and last stuck sample and at the end")
     ax.title.set_fontsize("small")
     ax.legend(fontsize="x-small", loc="lower left")

@@ -355,6 +355,11 @@ FIGURE = "recovery_question.png"
 FIGURES = {part: [FIGURE] for part in ("C6r-a", "C6r-b", "C6r-c", "C6r-d")}
 
 
+# The located transitions (friction lost: True), in colours no regime uses.
+TRANSITION_STYLE = {True: {"marker": "v", "color": "tab:brown", "label": "friction lost (located)"},
+                    False: {"marker": "^", "color": "tab:cyan", "label": "friction regained (located)"}}
+
+
 def draw(study: Study, save) -> None:
     """One panel per configuration: regimes on the omega grid at each A (in delta_0), the
     located transitions (bars: the bisection bracket), A_c(omega) and A_N(omega), k_n/gamma_n."""
@@ -376,7 +381,7 @@ def draw(study: Study, save) -> None:
         ax.plot(line, detachment_amplitude(line, 1.0, LOAD, k_n, gamma_n) / delta_0, "k-", lw=1, label="$A_c(\\omega)$")
         ax.plot(line, friction_loss_amplitude(line, 1.0, LOAD, k_n, gamma_n) / delta_0, "k--", lw=1,
                 label="$A_N(\\omega)$")
-        ax.axvline(k_n / gamma_n, color="tab:orange", lw=1, label="$k_n/\\gamma_n$")
+        ax.axvline(k_n / gamma_n, color="tab:olive", lw=1, label="$k_n/\\gamma_n$")
         shown = set()
         for r in group:
             level = r["A"] / delta_0
@@ -386,12 +391,20 @@ def draw(study: Study, save) -> None:
                            label=None if regime in shown else style["label"])
                 shown.add(regime)
             for t in r["transitions"]:
-                color = "tab:red" if t["kind"] == LOSS else "tab:blue"
-                ax.plot([t["value"]], [level * 1.5], marker="v", color=color, ms=7)
-                ax.annotate(f"{t['value']:.3g}", (t["value"], level * 1.75), ha="center", fontsize=7, color=color)
-        ax.set(xscale="log", yscale="log", ylim=(0.05, 3.0), xlabel="$\\omega$", ylabel="$A/\\delta_0$", title=label)
+                # Colours and markers of their own: the regimes' colours mean regimes only.
+                lost = t["kind"] == LOSS
+                style = TRANSITION_STYLE[lost]
+                ax.plot([t["value"]], [level * 1.5], marker=style["marker"], color=style["color"], ms=7,
+                        label=None if style["label"] in shown else style["label"])
+                shown.add(style["label"])
+                # The value above its marker, offset in points so that it never covers one.
+                ax.annotate(f"{t['value']:.3g}", (t["value"], level * 1.5), xytext=(0, 7), textcoords="offset points",
+                            ha="center", va="bottom", fontsize=7, color=style["color"])
+        ax.set(xscale="log", yscale="log", ylim=(0.05, 3.0), xlabel="$\\omega$ [$\\tau_0^{-1}$]",
+               ylabel="$A$ [$\\delta_0$]", title=label)
         ax.legend(fontsize=6, ncol=3, loc="lower left")
-    fig.suptitle("Friction lost (red triangles) and regained (blue) as located by bisection; scaled drive", fontsize=9)
+    fig.suptitle("Friction lost (brown, down) and regained (cyan, up) where bisection located it; markers below: the "
+                 "regime of each run; scaled drive", fontsize=9)
     save(fig, FIGURE)
 
 CLAIM = Claim("C6r", study_recovery, verdict_rows, TEXT, FIGURES, draw)

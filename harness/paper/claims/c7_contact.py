@@ -142,7 +142,7 @@ def draw(study: Study, save) -> None:
                 if curve.get(key) is not None:  # the bisected transitions, on the embedded threshold
                     ax.plot(curve[key], EMBEDDED, "|", ms=14, mew=2, color=line.get_color())
     ax.axvline(study.measured["k_n_over_gamma_n"], color="k", ls=":", label=r"$k_n/\gamma_n$")
-    ax.set(xscale="log", xlabel=r"$\omega$", ylabel="contact fraction")
+    ax.set(xscale="log", xlabel=r"$\omega$ [$\tau_0^{-1}$]", ylabel="contact fraction [1]")
     ax.legend(fontsize="small")
     save(fig, "contact_fraction.png")
 

@@ -145,7 +145,7 @@ def draw(study: Study, save) -> None:
         omega, velocity = np.meshgrid(d["omega"], d["V_d"])
         regime_scatter(ax, omega.ravel(), velocity.ravel(), np.asarray(d[key]).ravel())
         amplitude = study.measured["model_c_amplitude" if key == "regime_c" else "model_a_amplitude"]
-        ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="$V_d$", title=f"{title}, A = {amplitude:g}"
+        ax.set(xscale="log", yscale="log", xlabel=r"$\omega$ [$\tau_0^{-1}$]", ylabel=r"$V_d$ [$\delta_0/\tau_0$]", title=f"{title}, A = {amplitude:g} $\\delta_0$"
                + ("\nscaled $k_d = 10^{-2}$, $\\gamma_t = 5\\cdot10^{-3}$ on the paper's plate;\nthe paper's "
                   "A = 2e4 throws the block off the plate" if key == "regime_c" else ""))
         ax.title.set_fontsize(8)

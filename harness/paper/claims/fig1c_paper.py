@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from harness.runs.observables import PHI_STICK_SLIP
 from harness.runs.settings import ObservableSettings, PointSettings
 
 from .measure import friction_held, loss_amplitude, observe_json, onset_amplitude, run_and_measure
@@ -61,7 +62,7 @@ def study_fig1c_paper(runner: Runner) -> Study:
         rows.append({"A": a, "omega": w, "regime": o["regime"], "phi": o["phi"],
                      "contact_fraction": o["contact_fraction"], "rest_fraction": o["rest_fraction"],
                      "slips_in_window": sampled_slips(x[t >= transient])})
-    stick_slip = [row for row in rows if row["regime"] == "stick_slip"]
+    stick_slip = [row for row in rows if row["regime"] in PHI_STICK_SLIP]
     measured = {"points": rows, "cycle_time": period,
                 "fewest_slips_at_stick_slip": min((row["slips_in_window"] for row in stick_slip), default=None)}
     settings = {"model": "A", "parameters": "paper (FMU defaults)", "integrator": "event_driven",
@@ -108,7 +109,7 @@ def draw(study: Study, save) -> None:
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
     regime_grid(ax, d["omega"], d["A"], d["regime"], onset_amplitude, r"$A = g/\omega^2$", r"$A_c(\omega)$",
                 loss=loss_amplitude)
-    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$", ylabel="A",
+    ax.set(xscale="log", yscale="log", xlabel=r"$\omega$ [$\tau_0^{-1}$]", ylabel=r"$A$ [$\delta_0$]",
            title=f"Model A, the paper's parameters (>= {study.settings['cycles']} stick-slip cycles per point)")
     ax.title.set_fontsize(9)
     ax.set_ylim(min(d["A"]) / 1.5, max(d["A"]) * 1.5)

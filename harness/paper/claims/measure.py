@@ -8,7 +8,7 @@ Conventions used by all studies
 * Vibrated runs start on the steady in-contact orbit (``steady_orbit``).  Models B and
   C start at a valley (B) or a crest (C) of the corrugation, at the time when the drive
   spring is relaxed (start_time = x_start / V_d), so that no spring force acts at t0.
-* "Friction" = the block is held by friction in the window: regime stick_slip, stuck
+* "Friction" = the block is held by friction in the window: regime stick_slip, micro_slip, stuck
   (no slip and no sliding within the window) or jammed (self-locked on a flank);
   "sliding" = it follows the drive; "hopping" = it neither rests nor stays in contact;
   "flying" = no contact in the window (none of the three is friction).
@@ -58,7 +58,7 @@ def run_and_measure(item: dict, pool) -> dict:
     """One run: observables plus the extras named in ``item["extras"]`` (worker task)."""
     point: PointSettings = item["point"]
     extras = item.get("extras", ())
-    outputs = ("x", "vx", "phi_integral", "contact", "slip_count", "penetration")
+    outputs = ("x", "vx", "phi_integral", "contact", "coulomb_resets", "penetration")
     ds = simulate(point.run, pool, outputs=outputs)
     result = {"observables": observe(ds, point.observe).as_dict()}
     win = window(ds, point.observe.transient, point.observe.window)
@@ -151,7 +151,7 @@ def ramp_task(item: dict, pool) -> dict:
 
 # ---------------------------------------------------------------------- helpers
 def friction_held(regime: str) -> bool:
-    """Held by friction in the window: stick-slip, stuck or jammed (not sliding, hopping or flying)."""
+    """Held by friction in the window: stick-slip, micro-slip, stuck or jammed (not sliding, hopping or flying)."""
     return regime not in (SLIDING, HOPPING, FLYING)
 
 

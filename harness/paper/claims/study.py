@@ -179,6 +179,8 @@ class Runner:
             elif model in "BC":
                 fields["integration"] = CORRUGATED_INTEGRATION
                 parameters = {**CORRUGATED_TOLERANCES, **parameters}
+            else:  # the studies choose explicitly, whatever the FMUs' default
+                fields["integration"] = Integration("symplectic_euler")
         return RunSettings(fmu=self.fmus[model], parameters=parameters, **fields)
 
     def for_reading(self, reading: Reading, progress: bool | None = None, priority: int | None = None) -> "Runner":

@@ -4,9 +4,10 @@ energy balance, or with a clear error that states the limit.  Never a silent blo
 Energy bound: |energy_residual| <= BOUND[integrator] * scale, where scale = dissipated
 energy + |work input| + the energy stored at the end (kinetic, normal spring, drive
 spring): the dissipated energy alone is no scale when nothing dissipates (gamma -> 0, a
-block at rest).  Bounds: implicit_contact 1e-4 (second order, exact contact flows; the
-worst case here, 1.6e-5, is the 89 degree corrugation with k_n = 1e8, and it falls 4x
-per halving of dt), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), event_driven 1e-9
+block at rest).  The stored energy is booked as the potentials at the state.  Bounds:
+implicit_contact 1e-3 (exact contact flows; on a corrugated plate the conservative
+contact's curvature term is held over a step, first order: the worst case here is model B
+bouncing with k_n = 1e8, 6.3e-4), rk4 1e-6, symplectic_euler 2e-2 (first order in dt), event_driven 1e-9
 (exact flows: the worst case, 2e-12, is V_d = 1e3; adaptive on model A, which takes
 them, too), adaptive 1e-4 (on its own steps, at
 its default rtol = 1e-8; the worst case, 3.4e-5, is gamma_n = 1e4: the quadratures ride along
@@ -32,7 +33,7 @@ from fmu_testing import do_step, fmu_log  # noqa: F401 (fixture)
 from vibroblock import Block, ModelError
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
-BOUND = {"symplectic_euler": 2e-2, "rk4": 1e-6, "implicit_contact": 1e-4, "adaptive": 1e-4, "event_driven": 1e-9}
+BOUND = {"symplectic_euler": 2e-2, "rk4": 1e-6, "implicit_contact": 1e-3, "adaptive": 1e-4, "event_driven": 1e-9}
 HORIZON = 100.0
 
 REFUSED_STEP = r"too large for the .* use dt <="  # an explicit scheme's stability limit, with the admissible dt
@@ -60,7 +61,10 @@ MATRIX = {
                                                              EXPLICIT_REFUSE),
     "V_d = 1e-12": ("ABC", {"V_d": 1e-12}, ALL_RUN),
     "V_d = 1e3, flat": ("A", {"V_d": 1e3}, ALL_RUN),
-    "V_d = 1e3, corrugated": ("BC", {"V_d": 1e3}, {**ALL_RUN, "implicit_contact": TOO_FAST}),
+    # (the conservative contact holds the block on the first flank, deep in the plate: no step
+    # crosses the corrugation too fast; under the force along the normal it races across,
+    # which implicit_contact refuses: test_a_refused_case_keeps_the_last_good_state)
+    "V_d = 1e3, corrugated": ("BC", {"V_d": 1e3}, ALL_RUN),
 }
 
 
@@ -105,7 +109,10 @@ def test_extreme_case_is_finite_and_balanced_or_refused_clearly(model, run, para
 
 
 def test_a_refused_case_keeps_the_last_good_state():
-    block = Block("B", "implicit_contact", initial_state=2, **{**SCALED, "V_d": 1e3})
+    """V_d = 1e3 on the corrugation with the force along the normal: the block races across
+    faster than implicit_contact's frozen frame allows."""
+    block = Block("B", "implicit_contact", initial_state=2, contact_law="linear_along_normal",
+                  **{**SCALED, "V_d": 1e3})
     block.start()
     before = block.outputs()
     with pytest.raises(ModelError, match=TOO_FAST):

@@ -44,10 +44,15 @@ def test_second_order_against_the_analytic_steady_orbit():
 
 
 @pytest.mark.parametrize("model", "BC")
-def test_second_order_on_the_corrugated_plate(model):
+@pytest.mark.parametrize("contact_law, fall", [("linear_along_normal", (3.0, 5.5)), ("linear", (1.4, math.inf))])
+def test_order_on_the_corrugated_plate(model, contact_law, fall):
     """Curvature, centripetal and Coriolis terms included: successive differences of the
-    state fall by 4 per halving of dt (no resets: k_t = mu_s = 0; a gentle corrugation)."""
-    settings = dict(SCALED, A=0.3, omega=1.1, mu_s=0.0, k_t=0.0, A_x=10.0, omega_x=0.1, initial_state=2)
+    state fall by 4 per halving of dt with the force along the normal (no resets: k_t =
+    mu_s = 0; a gentle corrugation).  The conservative contact's curvature term is held
+    over the step at its midpoint value, and the scheme converges at first order with it
+    (measured: the differences fall by 1.6-2 here): the order the README states."""
+    settings = dict(SCALED, A=0.3, omega=1.1, mu_s=0.0, k_t=0.0, A_x=10.0, omega_x=0.1, initial_state=2,
+                    contact_law=contact_law)
     finals = []
     for dt in (4e-3, 2e-3, 1e-3):
         block = Block(model, "implicit_contact", dt=dt, **settings)
@@ -55,7 +60,7 @@ def test_second_order_on_the_corrugated_plate(model):
         block.advance_to(20.0)
         finals.append(np.array([block.output(n) for n in ("x", "z", "vx", "vz")]))
     first, second = np.abs(finals[1] - finals[0]), np.abs(finals[2] - finals[1])
-    assert np.all(second < first / 3.0) and np.all(second > first / 5.5)
+    assert np.all(second < first / fall[0]) and np.all(second > first / fall[1])
 
 
 @pytest.mark.parametrize("model", "AC")
@@ -126,7 +131,9 @@ def test_results_do_not_depend_on_how_the_horizon_is_split(model):
 
 
 @pytest.mark.parametrize("model", "ABC")
-def test_energy_residual_falls_at_second_order(model):
+def test_energy_residual_falls_with_the_step(model):
+    """The residual (stored energy booked as the potentials) falls at second order on a flat
+    plate and at first order on a corrugated one under the conservative contact."""
     def residual(dt):
         block = Block(model, "implicit_contact", energy_balance=True, dt=dt, A=0.3, omega=1.2, initial_state=2,
                       **SCALED, **({"k_t": 0.0, "mu_s": 0.0, "A_x": 10.0, "omega_x": 0.1} if model != "A" else {}))
@@ -137,8 +144,8 @@ def test_energy_residual_falls_at_second_order(model):
         return abs(out["energy_residual"]) / out["energy_dissipated"]
 
     coarse, fine = residual(2e-3), residual(1e-3)
-    assert fine == pytest.approx(coarse / 4.0, rel=0.3)
-    assert coarse < 1e-6
+    assert fine == pytest.approx(coarse / (4.0 if model == "A" else 2.0), rel=0.3)
+    assert coarse < (1e-6 if model == "A" else 2e-5)
 
 
 def test_long_steps_on_a_flat_plate_stay_stable():

@@ -60,7 +60,8 @@ def test_rest_on_a_flank_balances_the_applied_load_and_the_drive(formulation, mo
     included), and the tangential spring holds the tangential applied force."""
     settings = dict(**GENTLE, k_d=5e-2, V_d=0.0, k_t=10.0, gamma_t=0.5, gamma_n=0.5, mu_s=1.0, **extra)
     x_start = math.acos(math.tan(math.radians(20.0)) / 0.5) / 0.5  # uphill flank, stretch x - V_d t = x > 0
-    run = reference.simulate(model, settings, 300.0, [300.0], formulation=formulation, x_start=x_start)
+    run = reference.simulate(model, settings, 300.0, [300.0], formulation=formulation, x_start=x_start,
+                             contact_law="linear_along_normal")  # (the statics derived for it)
     assert run.events == 0
     p, x = run.parameters, run.final("x")
     n_a = analytic.applied_normal(model, p, x, 300.0)
@@ -79,6 +80,7 @@ def _model_b_without_friction(formulation, **extra):
     x_start = roots[stable][np.argmin(np.abs(roots[stable]))]
     times = np.arange(5.0, 2000.1, 5.0)
     run = reference.simulate("B", settings, 2000.0, times, formulation=formulation, x_start=x_start,
+                             contact_law="linear_along_normal",
                              initial=2 if "A" in extra else 0)
     return p, x_start, times, run
 
@@ -136,8 +138,8 @@ def test_model_c_without_friction_never_sticks(formulation):
     away from the drive, so the block follows it (dx/dt near V_d), where model B sticks."""
     settings = dict(**GENTLE, k_d=5e-2, V_d=2e-2, gamma_t=0.3, k_t=0.0)
     times = np.arange(5.0, 1500.1, 5.0)
-    c = reference.simulate("C", settings, 1500.0, times, formulation=formulation)
-    b = reference.simulate("B", settings, 1500.0, times, formulation=formulation)
+    c = reference.simulate("C", settings, 1500.0, times, formulation=formulation, contact_law="linear_along_normal")
+    b = reference.simulate("B", settings, 1500.0, times, formulation=formulation, contact_law="linear_along_normal")
     late = times > 100.0
     assert np.all(np.abs(c["vx"][late] / settings["V_d"] - 1.0) < 0.05)
     assert np.mean(b["vx"][late] < 0.5 * settings["V_d"]) > 0.5

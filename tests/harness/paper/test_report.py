@@ -88,3 +88,26 @@ def test_each_study_reports_its_time_and_a_rerun_comes_from_the_store(tiny_job, 
         assert study.timing["points_computed"] == study.timing["tasks_computed"] == 0
         assert study.timing["compute_time"] == 0.0
         assert f"{name}: {study.timing['wall_time']:.1f} s, computing 0.0 s (store;" in printed
+
+
+def test_the_table_keeps_the_deciding_numbers_and_each_claim_has_its_section():
+    from harness.paper.claims.verdicts import Row
+
+    parts = [part for part in report.CLAIM_TEXT if part.startswith("C3")][:2]
+    assert len(parts) == 2
+    long_measured = "; ".join(f"omega = {w}: A boundary {w * 40:.3g} vs g/omega^2 {1 / w ** 2:.3g}"
+                              for w in (0.1, 0.16, 0.25, 0.4, 0.63, 1.0, 1.6, 2.5, 4.0, 6.3) * 4)
+    assert len(long_measured) > 1000
+    rows = [Row(parts[0], long_measured, AGREES, "every column within 10 %", figures=["fig1c.png"]),
+            Row(parts[1], long_measured, DISAGREES, "3 of 9 columns off by more than 10 %", figures=["fig1c.png"])]
+    short = report._short(long_measured)
+    assert len(short) <= report.TABLE_CELL + len(" ... (see below)") and short.startswith("omega = 0.1: A boundary")
+    assert short.endswith("(see below)")
+    sections = "\n".join(report.per_claim_markdown(rows, ["fig1c.png"]))
+    # The full measurement once, then named for the part that shares it.
+    assert sections.count(long_measured) == 1
+    assert f"*Measured:* the same runs and numbers as {parts[0]} (above)." in sections
+    assert "*Why disagrees:* 3 of 9 columns" in sections and "(Figure 1)" in sections
+    assert sections.count(f'<a id="{report._anchor(parts[0])}"></a>') == 1
+    caption = report.figure_caption("fig1c.png", rows)
+    assert caption.startswith(f"evidence for {parts[0]}, {parts[1]} -- ") and "delta_0" in caption

@@ -77,3 +77,14 @@ def test_the_linear_laws_agree_off_a_curved_plate():
         outputs.append(block.outputs())
     assert outputs[0] == outputs[1]
     assert np.isfinite(outputs[0]["energy_residual"])
+
+
+def test_an_integrator_a_law_refuses_is_refused_with_the_law_s_reason(monkeypatch):
+    """A law module's REFUSED_BY names the integrators whose closed forms assume another law."""
+    from vibroblock.laws import LAWS
+    law = LAWS["contact"][1]
+    monkeypatch.setitem(law.refused_by, "implicit_contact", "its closed forms assume the conservative law")
+    with pytest.raises(ModelError, match="implicit_contact integrator cannot run contact_law = 1 "
+                                         r"\(linear_along_normal\): its closed forms assume"):
+        Block("B", "implicit_contact", dt=1e-2, contact_law=1).start()
+    Block("B", "rk4", contact_law=1).start()  # the others run it

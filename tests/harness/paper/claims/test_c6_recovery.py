@@ -76,6 +76,18 @@ def test_recovery_is_judged_on_located_values_near_k_n_over_gamma_n_and_alike_ac
     assert c6c.verdict == DISAGREES and "within 25% of k_n/gamma_n in 1/2" in c6c.reason
 
 
+def test_independence_of_a_is_not_claimed_from_one_row():
+    """With omega_2 at one amplitude its spread over the rows is 0 whatever was measured:
+    that check cannot fail, so it is not counted, and the reason says it was not tested."""
+    ratio = 1 / 0.07
+    one = {r.claim: r for r in verdict_c6(measured([row(0.3, 3.0, 30.0, located_2=ratio * 1.05)]))}["C6c"]
+    assert "of its mean over the rows" not in one.reason
+    assert "independence of A not tested (omega_2 found at one amplitude only)" in one.reason
+    two = [row(0.3, 3.0, 30.0, located_2=ratio * 1.05), row(3.0, 1.0, 30.0, located_2=ratio * 1.5)]
+    spread = {r.claim: r for r in verdict_c6(measured(two))}["C6c"]
+    assert "of its mean over the rows" in spread.reason and spread.verdict == DISAGREES
+
+
 # ------------------------------------------------------------ the start-phase ensemble
 def test_the_start_phases_are_the_crest_both_flanks_and_the_valley():
     from harness.paper.claims.measure import OMEGA_X, START_PHASES
@@ -143,6 +155,23 @@ def test_both_sides_of_each_located_transition_are_rerun_from_four_starts_over_l
     else:
         assert verdicts["C6b"].verdict == NOT_REPRODUCED and verdicts["C6c"].verdict == NOT_REPRODUCED
         assert "valley sliding" in verdicts["C6b"].reason
+
+
+def test_the_start_ensemble_gets_a_figure_with_one_marker_per_start_and_side():
+    import matplotlib
+    matplotlib.use("Agg")
+    from harness.paper.claims.measure import START_PHASES
+
+    loss, back = (lambda a: 1 / math.sqrt(a)), (lambda a: 14.0 + a)
+    runner = StartDependent(loss, back, START_PHASES.get("valley"))
+    ensemble = c6_recovery._check_by_start_ensemble(runner, _located_rows(runner), wavelengths=3.0)
+    fig = c6_recovery.draw_start_ensemble(ensemble)
+    ax = fig.axes[0]
+    assert sum(len(c.get_offsets()) for c in ax.collections) == 4 * len(START_PHASES)
+    ticks = [t.get_text() for t in ax.get_xticklabels()]
+    assert len(ticks) == 4 and any("NOT confirmed" in t for t in ticks) and all("tau_0^{-1}" in t for t in ticks)
+    assert "phi" in ax.get_ylabel() and ax.get_yscale() == "log"
+    assert "start_ensemble.png" in c6_recovery.FIGURES["C6b"] and "start_ensemble.png" in c6_recovery.FIGURES["C6c"]
 
 
 def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive_and_draw_both_onsets():

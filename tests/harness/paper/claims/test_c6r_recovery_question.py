@@ -58,3 +58,30 @@ def test_verdicts_follow_the_measurements(tiny_study):
          "closest_A_c_root": None} for a in (0.3, 0.6)]}
     rows = {r.claim: r for r in recovery_study.verdict_rows(synthetic)}
     assert rows["C6r-b"].verdict == AGREES  # at k_n/gamma_n and the same for both amplitudes
+
+
+def test_the_figure_keeps_regime_colours_for_regimes_and_labels_off_the_markers():
+    from types import SimpleNamespace
+
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.colors import to_hex
+
+    from harness.paper.claims import c6r_recovery_question as c6r
+    from harness.paper.plots import REGIME_STYLE
+
+    regained = next(kind for kind in ("regain", "recovery", "regained") if kind != c6r.LOSS)
+    row = {"configuration": "model A", "k_n": c6r.K_N, "gamma_n": 0.07, "A": 0.3 * c6r.LOAD / c6r.K_N,
+           "omegas": [0.5, 0.9, 1.5], "regimes": ["stick_slip", "sliding", "stick_slip"],
+           "transitions": [{"kind": c6r.LOSS, "value": 0.87}, {"kind": regained, "value": 1.22}]}
+    drawn = []
+    c6r.draw(SimpleNamespace(measured={"rows": [row], "stiffness_rows": []}), lambda fig, name: drawn.append(fig))
+    ax = drawn[0].axes[0]
+    regime_colours = {to_hex(style["color"]) for style in REGIME_STYLE.values()}
+    marks = [line for line in ax.lines if line.get_marker() in ("v", "^")]
+    assert {to_hex(line.get_color()) for line in marks} == {to_hex("tab:brown"), to_hex("tab:cyan")}
+    assert not {to_hex(line.get_color()) for line in marks} & regime_colours
+    assert all(text.get_position() != text.xy and text.xyann == (0, 7) for text in ax.texts)
+    assert "[$\\tau_0^{-1}$]" in ax.get_xlabel() and "[$\\delta_0$]" in ax.get_ylabel()
+    labels = ax.get_legend_handles_labels()[1]
+    assert "friction lost (located)" in labels and "friction regained (located)" in labels

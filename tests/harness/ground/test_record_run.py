@@ -1,0 +1,113 @@
+"""``vibroblock record``: records in formats the product does not ship (obspy's own test
+data), end to end through the command line, and the processed record through the
+Excitation FMU in fmpy.
+
+The FMUs are built without the shipped kernels (quick to build); the block's run
+compiles what it needs once into the shared kernel cache.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import obspy
+import pytest
+
+REPO = Path(__file__).resolve().parents[3]
+OBSPY = Path(obspy.__file__).parent
+ULN_RECORD = OBSPY / "core" / "tests" / "data" / "IU_ULN_00_LH1_2015-07-18T02.mseed"  # MiniSEED, counts
+ULN_INVENTORY = OBSPY / "core" / "tests" / "data" / "IU_ULN_00_LH1.xml"            # its StationXML
+SAC_VOLTS = OBSPY / "io" / "sac" / "tests" / "data" / "seism.sac"                    # SAC, idep = volts
+
+
+@pytest.fixture(scope="module")
+def quick_fmus(tmp_path_factory):
+    import build_fmus
+
+    dest = tmp_path_factory.mktemp("quick_fmus")
+    for name in ("BlockA", "Excitation"):
+        build_fmus.build(name, dest, ship_kernels=False)
+    return dest
+
+
+def record(args, env, timeout=900):
+    return subprocess.run([sys.executable, "-m", "harness", "record", *map(str, args)], capture_output=True,
+                          text=True, cwd=str(REPO), env=env, timeout=timeout)
+
+
+def test_a_miniseed_record_with_its_stationxml_runs_and_plays_in_the_excitation_fmu(quick_fmus, tmp_path,
+                                                                                      subprocess_env):
+    from fmpy import simulate_fmu
+
+    saved = tmp_path / "uln.npz"
+    done = record([ULN_RECORD, "--inventory", ULN_INVENTORY, "--fmu", quick_fmus / "BlockA.fmu", "--freqmin", "0.02",
+                   "--time-stretch", "0.001", "--peak-g", "0.2", "--stop-time", "400", "--step", "1",
+                   "--save-record", saved, "--out", tmp_path], subprocess_env)
+    assert done.returncode == 0, done.stderr[-3000:]
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    # 1 kg on 1e5 N/m: tau_0 = 3.16 ms, so 1.11e4 s of record played 1000x faster last 3.5e3 tau_0.
+    assert result["record_duration"] == pytest.approx(1.11e4 * 0.001 / 3.1623e-3, rel=0.01)
+    assert result["stop_time"] == 400.0
+    assert len(result["notes"]) == 1 and "shorter than the processed record" in result["notes"][0]
+    assert "400 tau_0 = 1265 s of the record" in result["notes"][0]  # 400 x 3.1623 ms x 1000
+    assert (tmp_path / "record_response.png").is_file()
+    assert "peak_plate_acceleration_g" in done.stdout and "one slip holds many" in done.stdout
+    # The processed record (SI) plays in the Excitation FMU in fmpy.
+    played = simulate_fmu(str(quick_fmus / "Excitation.fmu"), stop_time=100.0, output_interval=1.0,
+                          start_values={"mode": 4, "record_file": str(saved), "amplitude_scale": 1.0,
+                                        "time_scale": 1.0})
+    with np.load(saved) as data:
+        assert data["acceleration"].size == result_samples(done.stdout)
+    assert np.any(played["plate_z"] != 0.0) and np.all(np.isfinite(played["plate_a"]))
+
+
+def result_samples(printed: str) -> int:
+    line = next(line for line in printed.splitlines() if line.startswith("record: "))
+    return int(line.split("), ", 1)[1].split(" samples")[0])
+
+
+def test_a_sac_record_in_volts_needs_a_sensitivity_and_runs_with_one(quick_fmus, tmp_path, subprocess_env):
+    refused = record([SAC_VOLTS, "--fmu", quick_fmus / "BlockA.fmu", "--quantity", "velocity", "--unit", "m/s"],
+                     subprocess_env)
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert "counts or volts" in refused.stderr and "--sensitivity" in refused.stderr
+    done = record([SAC_VOLTS, "--fmu", quick_fmus / "BlockA.fmu", "--quantity", "velocity", "--unit", "m/s",
+                   "--sensitivity", "1e3", "--freqmin", "1", "--peak-g", "0.3", "--time-stretch", "30", "--step", "5",
+                   "--out", tmp_path], subprocess_env)
+    assert done.returncode == 0, done.stderr[-3000:]
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    assert result["notes"] == [] and result["stop_time"] == pytest.approx(result["record_duration"], abs=5.0)
+    assert "counts divided by the stated sensitivity" not in done.stdout  # the history is not printed
+    peak = next(line for line in done.stdout.splitlines() if "peak_plate_acceleration_g" in line)
+    assert float(peak.split()[1]) == pytest.approx(0.3, rel=0.05)  # --peak-g is the plate's peak, after stretching
+
+
+def test_the_excitation_fmu_plays_a_miniseed_record_with_its_response_in_fmpy(quick_fmus, tmp_path, subprocess_env):
+    """record_file names obspy's MiniSEED (counts), record_inventory its StationXML: the FMU
+    processes it at initialization as harness.ground.records does (same acceleration)."""
+    from fmpy import simulate_fmu
+
+    from harness.ground.records import load_ground_motion
+
+    fmu = str(quick_fmus / "Excitation.fmu")
+    played = simulate_fmu(fmu, stop_time=4000.0, output_interval=1.0,
+                          start_values={"mode": 4, "record_file": str(ULN_RECORD),
+                                        "record_inventory": str(ULN_INVENTORY), "amplitude_scale": 1.0,
+                                        "time_scale": 1.0})
+    motion = load_ground_motion(str(ULN_RECORD), inventory=str(ULN_INVENTORY))
+    # Played in the record's own seconds and metres: the samples at whole seconds are its own.
+    index = np.round(played["time"] / motion.dt).astype(int)
+    np.testing.assert_allclose(played["plate_a"], motion.acceleration[index], rtol=0,
+                               atol=1e-9 * np.max(np.abs(motion.acceleration)))
+    # Counts without their response are refused at initialization, with the parameter to set.
+    script = ("import sys\nfrom fmpy import simulate_fmu\ntry:\n    simulate_fmu(sys.argv[1], stop_time=1.0, "
+              "start_values={'mode': 4, 'record_file': sys.argv[2]})\nexcept Exception as exc:\n"
+              "    print('raised:', exc)\n")
+    done = subprocess.run([sys.executable, "-c", script, fmu, str(ULN_RECORD)], capture_output=True, text=True,
+                          env=subprocess_env, timeout=300)
+    errors = [line for line in done.stdout.splitlines() if line.startswith("[ERROR]")]
+    assert len(errors) == 1 and "holds counts without an instrument response" in errors[0]
+    assert "set record_inventory" in errors[0] and "raised:" in done.stdout
