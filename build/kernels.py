@@ -119,8 +119,9 @@ def shipped_jobs(model: str) -> list[str]:
     event_driven's exact flows, those) and its own."""
     from vibroblock import Block
     from vibroblock.integrators import BY_ID, INTEGRATORS, integrator
+    from vibroblock.parameters import DEFAULT_INTEGRATOR  # the FMU's where the master does not choose
 
-    names = {Block(model).settings.integrator} | {
+    names = {DEFAULT_INTEGRATOR} | {
         name for name in SHIPPED_ALWAYS if name in INTEGRATORS and integrator(name).supports(model)}
     ids = set()
     for name in names:

@@ -214,13 +214,13 @@ def first_steps(fmu_dir: Path, scratch: Path) -> None:
 
 def non_defaults(fmu_dir: Path, scratch: Path) -> None:
     sys.path.insert(0, str(CORE.parent))
-    from vibroblock import INTEGRATORS, Block
+    from vibroblock import INTEGRATORS
+    from vibroblock.parameters import DEFAULT_INTEGRATOR
 
     print("\n4. cold first doStep of configurations that are not a default (fresh process, empty cache; "
           "target <= 30 s, then cached)")
-    cases = [("A", {"integrator": INTEGRATORS[name]}) for name in INTEGRATORS
-             if name != Block("A").settings.integrator]
-    if Block("B").settings.integrator != "adaptive":
+    cases = [("A", {"integrator": INTEGRATORS[name]}) for name in INTEGRATORS if name != DEFAULT_INTEGRATOR]
+    if DEFAULT_INTEGRATOR != "adaptive":
         cases.append(("B", {"integrator": INTEGRATORS["adaptive"]}))
     cases += [("B", {"formulation": 1}), ("B", {"contact_law": 1, "coulomb_normal": 1})]
     for model, settings in cases:
