@@ -9,7 +9,9 @@ export MPLBACKEND := Agg
 INSTALLED := $(VENV)/.installed
 # One FMU per registered model variant (fmu_src/vibroblock/models) plus fmu_src's own
 # FMU scripts: the build derives the list (build/build_fmus.py --list), so the stamp
-# stands for all of them.
+# stands for all of them.  The build compiles every integrator's kernels once, one child
+# process per core (build/kernels.py, kept in build/work/ for the tests); each Block FMU
+# ships its default configuration's.
 FMUS := build/fmus/.built
 FMU_SOURCES := $(shell find fmu_src harness/ground/records -name '*.py' -o -name '*.npz') build/build_fmus.py build/status_shim.py build/fmi_status_shim.c \
 	build/python_runtime.c build/python_runtime.h build/kernels.py build/documentation.py

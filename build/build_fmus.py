@@ -179,7 +179,7 @@ def build(name: str, dest: Path, ship_kernels: bool = True) -> Path:
     extra = {PYTHON_ENVIRONMENT: python_environment_record(), **documentation.archive_members(name)}
     if name.startswith("Block") and ship_kernels:
         import kernels
-        extra.update(kernels.archive_members(CORE))
+        extra.update(kernels.archive_members(CORE, name[len("Block"):]))
     finish_archive(fmu, extra)
     return fmu
 

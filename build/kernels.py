@@ -1,31 +1,42 @@
-"""Compiled kernels shipped inside the Block FMUs, so that a first doStep does not compile.
+"""Compiled kernels: every integrator's compiled once per build, each Block FMU ships its default's.
 
-Without them, the first ``doStep`` of a freshly installed FMU compiles the numba
-kernels of the physics core (about 25 s on a 2-core machine, ~45 s more for the
-adaptive integrator in a non-default reading).  At build time child processes, one per
-core, run every model, integrator, reading and scene option of the core once with an
-empty numba cache; the cache they leave (index and data files, filed by the core's
-content-addressed locator, ``vibroblock/jitcache.py``) is packed into the FMU as
-``resources/vibroblock_kernels/``.  At run time the core copies these files into the
-host's numba cache where it has none yet, and numba uses them if they match the
-host: the same numba and Python versions and the same CPU (name and features).
-Otherwise it compiles as before and keeps its own copy.  A test session seeds its
-cache from the same folder (``tests/conftest.py``), so the tests, which run the same
-core, do not compile them again.
+The kernels take the run's variant, readings and laws (``kind``) as a plain integer and
+only the integrator (``method``) as a compile-time constant, so one compilation per
+integrator serves every model, reading, law, scene flag, energy option and initial
+state.  What is compiled when:
 
-The compiled set is kept in ``build/work/kernels-<key>`` with a key of everything it
-depends on (core sources, Python, numba, llvmlite, CPU), so rebuilding an FMU reuses
-it and builds stay byte-reproducible.
+* ``make fmus`` compiles every integrator's kernels once (``KERNEL_JOBS``: the advance
+  and observe entry points of each integrator record, with their C entries of
+  ``vibroblock.native``), one job per integrator in child processes, one per core, each
+  job with an empty numba cache of its own.  The caches are kept in
+  ``build/work/kernels-<key>/<job>/`` with a key of everything they depend on (core
+  sources, Python, numba, llvmlite, CPU), so rebuilding an FMU reuses them and builds
+  stay byte-reproducible.  A test session seeds its cache from all of them
+  (``tests/conftest.py``), so the tests do not compile them again.
+* A Block FMU ships only the kernels its default configuration runs (``shipped_jobs``,
+  derived from the core's settings: the default integrator, the kernels it hands a run
+  over to, e.g. ``adaptive`` on model A to ``event_driven``'s exact flows, and the
+  integrator's own kernels), and those too dear to compile at a first use
+  (``SHIPPED_ALWAYS``), packed as ``resources/vibroblock_kernels/`` (entry points only,
+  ``entry_files``).  At run time
+  the core copies them into the host's numba cache where it has none yet
+  (``vibroblock/jitcache.py``), and numba uses them if they match the host: the same
+  numba and Python versions and the same CPU (name and features).
+* Any other configuration (another integrator, or a scene reduction) compiles its
+  integrator's kernels at first use into the host's cache, once per core version; every
+  model, reading and law of that integrator then runs from it.
 """
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import platform
 import shutil
 import subprocess
 import sys
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -33,88 +44,47 @@ WORK_DIR = HERE / "work"
 ARCHIVE_FOLDER = "resources/vibroblock_kernels"
 # Children compiling kernels side by side (one per core, as numba compiles on one).
 MAX_CHILDREN = 8
+# Integrators whose kernels every Block FMU ships although no default runs them: compiling
+# them at a first use would take longer than a first use may (issue 33: 30 s).  adaptive's
+# took 69 s of CPU on the 2-core machine, the others 6-20 s (build_cost, section 1).
+SHIPPED_ALWAYS = ("adaptive",)
+# Relative compile costs measured on one core (harness/benchmarks/build_cost.py), so the
+# most expensive jobs start first and the children finish together.
+COST = {"adaptive": 10, "event_driven": 4, "implicit_contact": 3}
 
-# Runs in child processes with the core's parent folder on sys.path and one shared,
-# initially empty NUMBA_CACHE_DIR.  Every configuration a master can choose goes
-# through the same calls an FMU makes (start, inputs, advance, outputs, state): every
-# model, integrator and scene option in the default reading, every model and
-# integrator in each other reading of the paper (vibroblock.readings: each is a
-# kernel of its own), and each integrator option that changes what runs
-# (parameters.INTEGRATOR_OPTIONS: exact_flows off runs adaptive's own steps on model A).
-# A configuration the core refuses is skipped.  The work is cut
-# into jobs that compile disjoint kernels (one model, reading and integrator each),
-# dealt out to `shares` children by their expected cost; child `share` runs its part.
+# Child process, run with the core's parent folder on sys.path and an empty NUMBA_CACHE_DIR
+# of its own: the kernels of one integrator record (``vibroblock.integrators.BY_ID``),
+# through the calls an FMU makes (start, inputs, advance, outputs, state, the C entries),
+# in the first configuration the core accepts for it.  Prints the configuration as JSON.
 WARM_UP = r"""
-import itertools, sys
-import vibroblock
+import itertools, json, sys
 from vibroblock import Block, INTEGRATORS, ModelError
+from vibroblock.integrators import BY_ID
+from vibroblock.models import VARIANTS
 from vibroblock.native import NativeStep
-from vibroblock.models import VARIANTS, offered_by
 from vibroblock.parameters import INTEGRATOR_OPTIONS, SCENE_OPTIONS
-from vibroblock.readings import choices
-READINGS = choices()
 
-share, shares = map(int, sys.argv[1:3])
-# Relative compile costs (adaptive kernels, RODAS4 and DOP853, take ~45 s of CPU each, a
-# fixed-step scheme a few seconds), so that the children finish together.
-COST = {"adaptive": 10, "event_driven": 6, "implicit_contact": 3}
-
-jobs = []
-for model in VARIANTS:
-    names = [name for name, (models, _) in READINGS.items() if model in offered_by(models)]
-    for values in itertools.product((0, 1), repeat=len(names)):
-        reading = dict(zip(names, values))
-        for integrator in INTEGRATORS:
-            if any(values):
-                configs = [(reading, False, 0)]
-            else:
-                scenes = [{}] + [{name: True} for name, (models, _) in SCENE_OPTIONS.items()
-                                 if model in offered_by(models)]
-                configs = [(scene, energy, initial) for energy, scene, initial
-                           in itertools.product((False, True), scenes, (0, 2))]
-            cost = COST.get(integrator, 2) * (1 if any(values) else 3)
-            jobs.append((cost, model, integrator, configs))
-            # An option that changes what runs (adaptive's exact_flows on model A: its own
-            # steps instead of event_driven's flows) has kernels of its own.
-            for name, (models, default, _) in INTEGRATOR_OPTIONS.items():
-                if model not in offered_by(models):
-                    continue
-                try:
-                    as_default = Block(model, integrator, **reading).settings.kernel()
-                    changed = Block(model, integrator, **reading, **{name: not default}).settings.kernel()
-                except ModelError:
-                    continue
-                if changed is not as_default:  # (a scene reduction runs its own scheme either way)
-                    jobs.append((cost, model, integrator,
-                                 [({**options, name: not default}, energy, initial) for options, energy, initial
-                                  in configs if not set(options) & set(SCENE_OPTIONS)]))
-
-load = [0] * shares
-mine = []
-for cost, model, integrator, configs in sorted(jobs, key=lambda job: -job[0]):
-    child = load.index(min(load))
-    load[child] += cost
-    if child == share:
-        mine.append((model, integrator, configs))
-
-done = refused = 0
-for model, integrator, configs in mine:
-    for options, energy, initial in configs:
-        try:
-            block = Block(model, integrator, initial, energy, A=0.3, omega=0.5, **options)
-            block.drive_natively(NativeStep(), 1e-9)  # as the FMU's slave: its C entry too
-            block.start(0.0)
-            block.advance_to(1.0)
-            block.set_plate_input(0.01, 0.0, 0.0)
-            block.advance_to(2.0)
-            block.outputs()
-            block.set_state(block.get_state())
-            done += 1
-        except ModelError:
-            refused += 1
-print(f"share {share}/{shares}: warmed up {done} configurations ({refused} refused)")
-if done == 0 and mine:
-    sys.exit("no configuration could be run")
+job = sys.argv[1]
+options = [{}] + [{name: True} for name in SCENE_OPTIONS] + [
+    {name: not default} for name, (_, default, _) in INTEGRATOR_OPTIONS.items()]
+for model, integrator, option in itertools.product(VARIANTS, INTEGRATORS, options):
+    try:
+        block = Block(model, integrator, 0, True, A=0.3, omega=0.5, **option)
+        if BY_ID[block.settings.kernel().id].name != job:
+            continue
+        block.drive_natively(NativeStep(), 1e-9)  # as the FMU's slave: its C entries too
+        block.start(0.0)
+    except ModelError:
+        continue
+    block.advance_to(1.0)
+    block.set_plate_input(0.01, 0.0, 0.0)
+    block.advance_to(2.0)
+    block.outputs()
+    block.set_state(block.get_state())
+    print(json.dumps({"job": job, "model": model, "integrator": integrator, "options": option}))
+    break
+else:
+    sys.exit(f"no configuration runs the kernels of {job}")
 """
 
 
@@ -135,10 +105,59 @@ def _key(core: Path) -> str:
     return digest.hexdigest()[:16]
 
 
+def kernel_jobs() -> list[str]:
+    """One job per compiled kernel pair: the names of the integrator records by id
+    (``adaptive`` handing model A over runs ``event_driven``'s, the same id)."""
+    from vibroblock.integrators import BY_ID
+    return sorted({record.name for record in BY_ID.values()}, key=lambda name: (-COST.get(name, 1), name))
+
+
+def shipped_jobs(model: str) -> list[str]:
+    """The jobs whose kernels the Block FMU of ``model`` ships: for its default integrator
+    and each of ``SHIPPED_ALWAYS`` the model offers, the kernels it runs in the default
+    configuration (where it hands the run over, e.g. adaptive on model A to
+    event_driven's exact flows, those) and its own."""
+    from vibroblock import Block
+    from vibroblock.integrators import BY_ID, INTEGRATORS, integrator
+    from vibroblock.parameters import DEFAULT_INTEGRATOR  # the FMU's where the master does not choose
+
+    names = {DEFAULT_INTEGRATOR} | {
+        name for name in SHIPPED_ALWAYS if name in INTEGRATORS and integrator(name).supports(model)}
+    ids = set()
+    for name in names:
+        ids |= {Block(model, name).settings.kernel().id, integrator(name).id}
+    return sorted(BY_ID[i].name for i in ids)
+
+
+def entry_files(job_cache: Path) -> list[Path]:
+    """The cache files of a job's entry points only: its advance and observe kernels and
+    their C entries, each a self-contained library.  The helpers they call and inline were
+    cached on their own as well, but loading an entry point does not read them."""
+    from vibroblock.integrators import BY_ID
+
+    record = next(record for record in BY_ID.values() if record.name == job_cache.name)
+    # numba names a cache file "<module>.<qualname>-<line>..." (module without its package).
+    prefixes = tuple(f"{kernel.py_func.__module__.rsplit('.', 1)[-1]}.{kernel.py_func.__qualname__}-"
+                     for kernel in (record.advance, record.observe)) + ("native.",)
+    return [path for path in sorted(job_cache.rglob("*.nb?")) if path.name.startswith(prefixes)]
+
+
 def kept_kernels(core: Path) -> Path | None:
-    """The folder of kernels compiled for the core at ``core`` by an earlier build, if any."""
+    """The folder of kernels compiled for the core at ``core`` by an earlier build, if any:
+    one subfolder (a numba cache) per job."""
     folder = WORK_DIR / f"kernels-{_key(core)}"
     return folder if folder.is_dir() else None
+
+
+def _compile_job(job: str, core: Path, scratch: Path) -> dict:
+    cache = scratch / job
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(core.parent))
+    env.pop("NUMBA_DISABLE_JIT", None)
+    child = subprocess.run([sys.executable, "-c", WARM_UP, job], env=env, cwd=scratch, capture_output=True,
+                           text=True, timeout=3600)
+    if child.returncode != 0:
+        raise RuntimeError(f"compiling the kernels of {job} failed:\n{child.stdout}\n{child.stderr[-4000:]}")
+    return json.loads(child.stdout.strip().splitlines()[-1])
 
 
 def compile_kernels(core: Path) -> Path:
@@ -149,24 +168,12 @@ def compile_kernels(core: Path) -> Path:
     WORK_DIR.mkdir(parents=True, exist_ok=True)
     scratch = Path(tempfile.mkdtemp(dir=WORK_DIR, prefix=".kernels-"))
     try:
-        env = dict(os.environ, NUMBA_CACHE_DIR=str(scratch / "cache"), PYTHONPATH=str(core.parent))
-        env.pop("NUMBA_DISABLE_JIT", None)
-        shares = max(1, min(os.cpu_count() or 1, MAX_CHILDREN))
-        children = [subprocess.Popen([sys.executable, "-c", WARM_UP, str(share), str(shares)], env=env,
-                                     cwd=scratch, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-                    for share in range(shares)]
-        failures = []
-        for child in children:
-            try:
-                out, err = child.communicate(timeout=3600)
-            except subprocess.TimeoutExpired:
-                child.kill()
-                out, err = child.communicate()
-            if child.returncode != 0:
-                failures.append(f"{out}\n{err[-4000:]}")
-        if failures:
-            raise RuntimeError("compiling the kernels failed:\n" + "\n".join(failures))
-        os.replace(scratch / "cache", target)
+        jobs = kernel_jobs()
+        children = max(1, min(os.cpu_count() or 1, MAX_CHILDREN, len(jobs)))
+        with ThreadPoolExecutor(children) as pool:  # each thread waits on one child process
+            configurations = list(pool.map(lambda job: _compile_job(job, core, scratch), jobs))
+        (scratch / "jobs.json").write_text(json.dumps(configurations, indent=1) + "\n")
+        os.replace(scratch, target)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     for stale in WORK_DIR.glob("kernels-*"):
@@ -175,8 +182,18 @@ def compile_kernels(core: Path) -> Path:
     return target
 
 
-def archive_members(core: Path) -> dict[str, bytes]:
-    """The FMU members ``resources/vibroblock_kernels/...`` for the core at ``core``."""
+def job_caches(core: Path) -> list[Path]:
+    """The numba cache folders of every job, compiled if not kept yet."""
     folder = compile_kernels(core)
-    return {f"{ARCHIVE_FOLDER}/{path.relative_to(folder).as_posix()}": path.read_bytes()
-            for path in sorted(folder.rglob("*")) if path.is_file() and path.suffix in (".nbi", ".nbc")}
+    return [folder / job for job in kernel_jobs()]
+
+
+def archive_members(core: Path, model: str) -> dict[str, bytes]:
+    """The FMU members ``resources/vibroblock_kernels/...`` of the Block FMU of ``model``:
+    the kernels of ``shipped_jobs`` for the core at ``core``."""
+    folder = compile_kernels(core)
+    members = {}
+    for job in shipped_jobs(model):
+        for path in entry_files(folder / job):
+            members[f"{ARCHIVE_FOLDER}/{path.relative_to(folder / job).as_posix()}"] = path.read_bytes()
+    return members

@@ -22,14 +22,16 @@ exit_guard.install()
 
 @pytest.fixture(scope="session", autouse=True)
 def kernels_compiled_by_the_build():
-    """The build compiles every kernel of the core once (build/kernels.py) to ship it in
-    the FMUs; the tests' own cache starts from those instead of compiling them again."""
+    """The build compiles every integrator's kernels once (build/kernels.py: one numba
+    cache per integrator, the FMUs ship their defaults'); the tests' own cache starts from
+    all of them instead of compiling them again."""
     import kernels
     from vibroblock import jitcache
 
     folder = kernels.kept_kernels(ROOT / "fmu_src" / "vibroblock")
     if folder is not None:
-        jitcache.seed_cache(folder)
+        for job in sorted(path for path in folder.iterdir() if path.is_dir()):
+            jitcache.seed_cache(job)
 
 
 @pytest.fixture(scope="session")

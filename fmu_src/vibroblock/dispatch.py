@@ -31,6 +31,8 @@ def by_kind(functions: dict, selector: str, arguments: str, takes_kind: bool = F
         lines.append(f"        result = _{values[-1]}({passed})")
         lines.append("    return result")
     exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registries' integer keys only
-    # Compiled on its own (numba's own inliner trips on the branches' shared result) and
-    # small enough for LLVM to inline it where it is called.
-    return njit(namespace["dispatch"])
+    # Inlined into its callers: a call of a separately compiled function would pass its
+    # arrays with a reference count taken and dropped per call, which costs the fixed-step
+    # kernels up to 4x.  (numba's SSA check then warns that the branches' shared result
+    # is "not in scope"; it is a pedantic warning of numba's own, filtered in jitcache.)
+    return njit(inline="always")(namespace["dispatch"])
