@@ -10,7 +10,7 @@ import pytest
 
 from harness.runs.continuation import Ramp, continuation, fresh_starts
 from harness.cosim.fmu import FmuInstance, InstancePool
-from harness.runs.observables import SLIDING, STICK_SLIP
+from harness.runs.observables import MICRO_SLIP, SLIDING, STICK_SLIP
 from harness.runs.settings import ObservableSettings, PointSettings, RunSettings
 
 OMEGA = 0.5
@@ -40,8 +40,8 @@ def test_a_ramp_down_keeps_bouncing_where_a_fresh_start_stays_embedded(fmu_a):
     fresh_low = fresh.sel(step=0)
     # The first step is a fresh start: same numbers.
     assert up_low.phi.item() == fresh_low.phi.item()
-    # Embedded (always in contact) with stick-slip, from a fresh start at A < A_c ...
-    assert fresh_low.contact_fraction.item() == 1.0 and fresh_low.regime.item() == STICK_SLIP
+    # Embedded (always in contact) with stick-slip or micro-slips, from a fresh start at A < A_c ...
+    assert fresh_low.contact_fraction.item() == 1.0 and fresh_low.regime.item() in (STICK_SLIP, MICRO_SLIP)
     # ... bouncing at the top of the ramp ...
     assert top.contact_fraction.item() < 0.5 and top.regime.item() == SLIDING
     # ... and still bouncing and sliding at the same A < A_c on the way down.
