@@ -123,7 +123,8 @@ class Block:
         self.settings.locked = True
         self._observed = None
         obs = self._observe()
-        self.y[L.Y_E_NORMAL] = contact_energy(self.settings, self.prm, obs[L.O_PENETRATION])
+        # The contact's energy starts at its potential (a reduced scene integrates its power from there).
+        self.y[L.Y_E_NORMAL] = obs[L.O_E_NORMAL] = contact_energy(self.settings, self.prm, obs[L.O_PENETRATION])
         self.y[L.Y_E_START] = stored_energy(self.settings, self.prm, obs, t0)
 
     def _retune_drive(self) -> None:
