@@ -136,8 +136,9 @@ def entry_files(job_cache: Path) -> list[Path]:
     from vibroblock.integrators import BY_ID
 
     record = next(record for record in BY_ID.values() if record.name == job_cache.name)
-    # numba names a cache file "<module>.<qualname>-<line>..." (module without its package).
-    prefixes = tuple(f"{kernel.py_func.__module__.rsplit('.', 1)[-1]}.{kernel.py_func.__qualname__}-"
+    # numba names a cache file "<source file's stem>.<qualname>-<line>..." ("__init__" for
+    # a kernel defined in a package's __init__.py, e.g. event_driven's).
+    prefixes = tuple(f"{Path(kernel.py_func.__code__.co_filename).stem}.{kernel.py_func.__qualname__}-"
                      for kernel in (record.advance, record.observe)) + ("native.",)
     return [path for path in sorted(job_cache.rglob("*.nb?")) if path.name.startswith(prefixes)]
 
