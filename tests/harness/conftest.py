@@ -26,3 +26,14 @@ def subprocess_env() -> dict:
     env["NUMBA_CACHE_DIR"] = os.environ["NUMBA_CACHE_DIR"]
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO), env.get("PYTHONPATH")]))
     return env
+
+
+@pytest.fixture(scope="module")
+def quick_fmus(tmp_path_factory):
+    """BlockA.fmu and Excitation.fmu of the working tree, without shipped kernels."""
+    import build_fmus
+
+    dest = tmp_path_factory.mktemp("quick_fmus")
+    for name in ("BlockA", "Excitation"):
+        build_fmus.build(name, dest, ship_kernels=False)
+    return dest

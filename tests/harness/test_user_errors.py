@@ -25,17 +25,6 @@ ULN_RECORD = OBSPY_DATA / "IU_ULN_00_LH1_2015-07-18T02.mseed"
 ULN_INVENTORY = OBSPY_DATA / "IU_ULN_00_LH1.xml"
 
 
-@pytest.fixture(scope="module")
-def quick_fmus(tmp_path_factory):
-    """BlockA.fmu and Excitation.fmu of the working tree, without shipped kernels."""
-    import build_fmus
-
-    dest = tmp_path_factory.mktemp("quick_fmus")
-    for name in ("BlockA", "Excitation"):
-        build_fmus.build(name, dest, ship_kernels=False)
-    return dest
-
-
 def run(args, env, cwd=REPO, timeout=300):
     return subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True, cwd=str(cwd), env=env,
                           timeout=timeout)

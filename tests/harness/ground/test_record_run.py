@@ -23,16 +23,6 @@ ULN_INVENTORY = OBSPY / "core" / "tests" / "data" / "IU_ULN_00_LH1.xml"         
 SAC_VOLTS = OBSPY / "io" / "sac" / "tests" / "data" / "seism.sac"                    # SAC, idep = volts
 
 
-@pytest.fixture(scope="module")
-def quick_fmus(tmp_path_factory):
-    import build_fmus
-
-    dest = tmp_path_factory.mktemp("quick_fmus")
-    for name in ("BlockA", "Excitation"):
-        build_fmus.build(name, dest, ship_kernels=False)
-    return dest
-
-
 def record(args, env, timeout=900):
     return subprocess.run([sys.executable, "-m", "harness", "record", *map(str, args)], capture_output=True,
                           text=True, cwd=str(REPO), env=env, timeout=timeout)
