@@ -47,12 +47,7 @@ def stored_energy(settings, prm, obs, t: float) -> float:
     x, vx, vz, shear = obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F]
     stretch = x - p["V_d"] * t
     friction = float(law("friction", settings.readings.get("friction_law", 0)).module.energy.py_func(shear, prm))
-    if any(settings.scene.values()):
-        # A reduced scene prescribes or removes the contact's motion (rigid contact, frozen
-        # vertical orbit): its kernel books the contact's energy as the power it integrates.
-        contact = obs[L.O_E_NORMAL]
-    else:
-        contact = contact_energy(settings, prm, obs[L.O_PENETRATION])
+    contact = contact_energy(settings, prm, obs[L.O_PENETRATION])
     return (0.5 * p["m"] * (vx * vx + vz * vz) + 0.5 * p["k_d"] * stretch * stretch + friction + contact)
 
 

@@ -38,7 +38,7 @@ import math
 from . import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
-from .dynamics import contact, friction_rule
+from .dynamics import contact, curvature_force, friction_rule
 from .laws import contact_dissipation, contact_elastic, friction_spring_force
 from .integrators.fixed_step import OK, STOP, book_energy, record_observation
 from .integrators.plate import drive_sin_cos, phase_after, plate_after, plate_at
@@ -98,6 +98,8 @@ def scene_step(kind, flags, prm, state, t, h, plate, frozen_end, track_energy):
         tangential -= friction_spring_force(kind, shear, prm)
     fx = drive + load_x + tangential * c
     fz = load_z + tangential * s
+    if not rigid and pen > 0.0:  # the compliant contact's full force, as in the full model
+        fx += curvature_force(kind, x, pen, c, s, prm)
     if rigid:
         # The impulse that cancels the inward normal velocity relative to the plate's
         # velocity at the step end; none if the block would leave by itself.
