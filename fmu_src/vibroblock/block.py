@@ -78,7 +78,9 @@ class Block:
             except ModelError:
                 self.parameters[name] = previous
                 raise
-            self._retune_drive()
+            # new A, omega from the current grid step on, the phase continuous
+            run_arrays.retune_drive(self.cnt, self.drv, self.parameters["A"], self.parameters["omega"])
+            self._observed = None
             if self.settings.kernel(self.frozen_released) is not self._kernel:
                 self._bind_kernels()
 
@@ -95,14 +97,10 @@ class Block:
             self._bind_kernels()
 
     def _release_frozen_vertical(self) -> None:
-        """The frozen_vertical guard hands over to the full model, which must run at this dt."""
+        """The frozen_vertical guard hands over to the full model, which must run at this dt
+        (if not, the block stays frozen: the next call meets the guard, and the error, again)."""
+        self.settings.check_hand_over(self.time)
         self.frozen_released = True
-        try:
-            self.settings.check(True)
-        except ModelError as exc:
-            self.frozen_released = False  # stays frozen: the next call meets the guard, and this error, again
-            raise ModelError(f"the frozen_vertical guard handed over to the full model at t = {self.time:g} (the "
-                             f"block would detach), which cannot run at this dt: {exc}") from None
         self._bind_kernels()
 
     # ------------------------------------------------------------------ running
@@ -123,23 +121,14 @@ class Block:
         self.settings.locked = True
         self._observed = None
         obs = self._observe()
-        # The contact's energy starts at its potential (a reduced scene integrates its power from there).
-        self.y[L.Y_E_NORMAL] = obs[L.O_E_NORMAL] = contact_energy(self.settings, self.prm, obs[L.O_PENETRATION])
+        self.y[L.Y_E_NORMAL] = contact_energy(self.settings, self.prm, obs[L.O_PENETRATION])  # the kernels' book of it
         self.y[L.Y_E_START] = stored_energy(self.settings, self.prm, obs, t0)
-
-    def _retune_drive(self) -> None:
-        """Take new A, omega from the current grid step on, keeping the phase continuous."""
-        run_arrays.retune_drive(self.cnt, self.drv, self.parameters["A"], self.parameters["omega"])
-        self._observed = None
 
     def set_plate_input(self, z: float, v: float, a: float) -> None:
         """External plate motion from the current time on: z + v tau + a tau^2 / 2."""
-        for name, value in (("plate_z", z), ("plate_v", v), ("plate_a", a)):
-            if not math.isfinite(value):
-                raise ModelError(f"input {name} = {value!r} is not finite; the previous input is kept")
+        run_arrays.check_plate_input(z, v, a)
         self._require_started()
-        self.drv[L.D_EXT_Z], self.drv[L.D_EXT_V], self.drv[L.D_EXT_A] = z, v, a
-        self.drv[L.D_EXT_T] = self.time
+        run_arrays.set_plate_input(self.drv, self.time, z, v, a)
         self._observed = None
 
     def _bind_kernels(self) -> None:
@@ -175,7 +164,8 @@ class Block:
         target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
         step = self._grid_step()
         if target - step > self._step_budget:
-            self._refuse_budget(t_end, target - step)
+            raise ModelError(self._kernel.budget_message(t=self.time, t_end=t_end, todo=target - step,
+                                                         dt=dt, budget=STEP_BUDGET_PER_CALL))
         while step < target:
             status = self._advance(target - step, self._track_energy)
             if status:
@@ -193,15 +183,6 @@ class Block:
         self.time = float(t0 + self._grid_step() * dt)
         self._observed = None
         self._release_frozen_vertical()
-
-    def _refuse_budget(self, t_end: float, todo: int) -> None:
-        dt = self._grid[1]
-        raise ModelError(
-            f"advancing from t = {self.time:g} to t = {t_end:g} takes {todo:.3g} internal steps of dt = {dt:g} "
-            f"with {self.integrator} (hours: ~{todo / 1e8 / 3600:.2g} h or more at 1e8 steps/s); one call may take "
-            f"at most {STEP_BUDGET_PER_CALL:.3g} steps so that a master is never held. Use shorter communication "
-            "steps, or a larger dt with implicit_contact (no contact stiffness limit), or event_driven (model A); "
-            "the state is kept.")
 
     def _require_started(self) -> None:
         if not self.started:
@@ -221,10 +202,7 @@ class Block:
         and the adaptive integrator's accepted internal steps, Jacobian evaluations and the
         plate periods it crossed by stroboscopic jumps."""
         self._require_started()
-        return {"steps": int(self.cnt[L.C_STEP]), "resets": int(self.cnt[L.C_SLIPS]),
-                "events": int(self.cnt[L.C_EVENTS]), "rejected": int(self.cnt[L.C_REJECTED]),
-                "accepted": int(self.cnt[L.C_ACCEPTED]), "jacobians": int(self.cnt[L.C_JACOBIANS]),
-                "periods_jumped": int(self.cnt[L.C_JUMPED])}
+        return run_arrays.counters(self.cnt)
 
     def _observe(self):
         """The observation array (``layout.O_*``) at the current time."""
@@ -258,12 +236,7 @@ class Block:
                 **run_arrays.saved(self.y, self.cnt, self.drv, self.prm)}
 
     def set_state(self, state: dict) -> None:
-        if state.get("model") != self.model:
-            raise ModelError(f"state of model {state.get('model')!r} cannot be set on a model {self.model} block")
-        try:
-            settings = Settings.from_dict(state)
-        except (KeyError, TypeError, ValueError) as exc:
-            raise ModelError(f"not a valid block state: {exc}") from None
+        settings = Settings.from_dict(state, self.model)
         arrays = run_arrays.restored(state)
         settings.locked = True
         self.settings = settings

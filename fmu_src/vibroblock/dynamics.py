@@ -133,8 +133,10 @@ def force(kind, x, t, engaged, penetration, normal, u_t, cos_a, sin_a, shear, pr
 
 
 @njit(inline="always")
-def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal, shear, plate_v, prm):
-    """Rates of the energy balance: work done on the block by the drive's far end, the
+def energy_rates(kind, x, velocity, shear, t, contact_now, plate_v, prm):
+    """Rates of the energy balance at the state (x, ``velocity`` = (vx, vz), shear F) whose
+    contact quantities are ``contact_now`` (``contact``; its penetration only gates the
+    contact's terms): work done on the block by the drive's far end, the
     plate and the load; power dissipated by the dashpots; power stored in the normal
     spring (-k_n delta u_n, which is d(k_n delta^2 / 2)/dt on a flat plate).
 
@@ -145,6 +147,8 @@ def energy_rates(kind, x, vx, vz, t, penetration, u_n, u_t, cos_a, sin_a, normal
     frame K = m (u^2 + w^2) / 2 and the normal components of load and drive spring work
     on zeta; the balance is again exact.
     """
+    vx, vz = velocity
+    penetration, u_n, u_t, cos_a, sin_a, normal = contact_now
     tangential = -prm[P_GT] * u_t
     dissipation = prm[P_GT] * u_t * u_t
     storage = 0.0

@@ -2,6 +2,8 @@
 restored whole (the FMU state), handed to the kernels as they are."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import layout as L
@@ -30,6 +32,24 @@ def retune_drive(cnt, drv, amplitude: float, omega: float) -> None:
     phase = reduced_phase(drv[L.D_PHASE], step_rate, n - cnt[L.C_PHASE_STEP])
     drv[L.D_PHASE], cnt[L.C_PHASE_STEP] = phase, n
     drv[L.D_AMP], drv[L.D_OMEGA] = amplitude, omega
+
+
+def check_plate_input(z: float, v: float, a: float) -> None:
+    for name, value in (("plate_z", z), ("plate_v", v), ("plate_a", a)):
+        if not math.isfinite(value):
+            raise ModelError(f"input {name} = {value!r} is not finite; the previous input is kept")
+
+
+def set_plate_input(drv, time: float, z: float, v: float, a: float) -> None:
+    """External plate motion from ``time`` on: z + v tau + a tau^2 / 2 (``Block.set_plate_input``)."""
+    drv[L.D_EXT_Z], drv[L.D_EXT_V], drv[L.D_EXT_A], drv[L.D_EXT_T] = z, v, a, time
+
+
+def counters(cnt) -> dict[str, int]:
+    """The run's cost counters by name (``Block.counters``)."""
+    return {"steps": int(cnt[L.C_STEP]), "resets": int(cnt[L.C_SLIPS]), "events": int(cnt[L.C_EVENTS]),
+            "rejected": int(cnt[L.C_REJECTED]), "accepted": int(cnt[L.C_ACCEPTED]),
+            "jacobians": int(cnt[L.C_JACOBIANS]), "periods_jumped": int(cnt[L.C_JUMPED])}
 
 
 def saved(y, cnt, drv, prm) -> dict:

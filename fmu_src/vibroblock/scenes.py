@@ -249,5 +249,5 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         normal = probe[6]
         in_contact = pen >= -ATTACHED_TOLERANCE * (1.0 + abs(z)) and normal > 0.0
     friction = probe[7] if coulomb else (-friction_spring_force(kind, shear, prm) if in_contact else 0.0)
-    return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,
-                              e_normal, in_contact, friction)
+    return record_observation(obs, (x, z, vx, vz, shear), (pen, normal, cos_a, in_contact),
+                              (phi, slips, work, dissipated, e_normal), t, friction)

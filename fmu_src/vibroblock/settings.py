@@ -252,8 +252,22 @@ class Settings:
                 "energy_balance": self.energy_balance, "scene": dict(self.scene),
                 "readings": dict(self.readings), "options": dict(self.options), "parameters": dict(self.parameters)}
 
+    def check_hand_over(self, time: float) -> None:
+        """The full model the frozen_vertical guard hands over to at ``time`` can run."""
+        try:
+            self.check(True)
+        except ModelError as exc:
+            raise ModelError(f"the frozen_vertical guard handed over to the full model at t = {time:g} (the "
+                             f"block would detach), which cannot run at this dt: {exc}") from None
+
     @classmethod
-    def from_dict(cls, data: dict) -> "Settings":
-        return cls(data["model"], data["integrator"], data["initial_state"], data["energy_balance"],
-                   **data["parameters"], **data.get("scene", {}), **data.get("readings", {}),
-                   **data.get("options", {}))
+    def from_dict(cls, data: dict, model: str | None = None) -> "Settings":
+        """The settings saved in ``data`` (``to_dict``), which must be of ``model`` if given."""
+        if model is not None and data.get("model") != model:
+            raise ModelError(f"state of model {data.get('model')!r} cannot be set on a model {model} block")
+        try:
+            return cls(data["model"], data["integrator"], data["initial_state"], data["energy_balance"],
+                       **data["parameters"], **data.get("scene", {}), **data.get("readings", {}),
+                       **data.get("options", {}))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"not a valid block state: {exc}") from None

@@ -199,6 +199,14 @@ class Integrator:
                                              else f"integrator {self.name} failed with status {status}")
         return text.format(integrator=self.name, **where)
 
+    def budget_message(self, t: float, t_end: float, todo: int, dt: float, budget: int) -> str:
+        """Why one call does not take ``todo`` > ``budget`` grid steps: an FMI master cannot
+        interrupt a doStep, so a request of hours is refused with its cost and the ways round."""
+        return (f"advancing from t = {t:g} to t = {t_end:g} takes {todo:.3g} internal steps of dt = {dt:g} with "
+                f"{self.name} (hours: ~{todo / 1e8 / 3600:.2g} h or more at 1e8 steps/s); one call may take at most "
+                f"{budget:.3g} steps so that a master is never held. Use shorter communication steps, or a larger "
+                "dt with implicit_contact (no contact stiffness limit), or event_driven (model A); the state is kept.")
+
 
 # (kernel, method) -> compiled entry point.  The kernels take ``method`` as a literal (a
 # fixed-step scheme is inlined into its driver's loop) and ``kind`` -- the variant, the

@@ -89,9 +89,13 @@ def kahan_add(total, compensation, value):
 
 
 @njit(inline="always")
-def record_observation(obs, x, z, vx, vz, shear, penetration, normal, cos_a, phi, slips, t, work, dissipated,
-                       e_normal, in_contact, friction):
-    """Fill the observation array (``layout.O_*``): the one layout every observe kernel returns."""
+def record_observation(obs, state, contact_now, sums, t, friction):
+    """Fill the observation array (``layout.O_*``): the one layout every observe kernel
+    returns.  ``state`` = (x, z, vx, vz, F); ``contact_now`` = (penetration, normal force,
+    cos a, in contact); ``sums`` = (phi, resets, work, dissipated, normal spring energy)."""
+    x, z, vx, vz, shear = state
+    penetration, normal, cos_a, in_contact = contact_now
+    phi, slips, work, dissipated, e_normal = sums
     obs[O_X], obs[O_Z], obs[O_VX], obs[O_VZ], obs[O_F] = x, z, vx, vz, shear
     obs[O_PENETRATION], obs[O_NORMAL], obs[O_COS] = penetration, normal, cos_a
     obs[O_PHI], obs[O_SLIPS], obs[O_T] = phi, slips, t
@@ -238,5 +242,6 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
                                                  (d_work, d_dissipated, d_normal), loaded, shear, track_energy)
         t += h
     pen, u_n, u_t, cos_a, sin_a, normal = state_contact
-    return record_observation(obs, x, z, vx, vz, shear, pen, normal, cos_a, phi, slips, t, work, dissipated,
-                              e_normal, pen > 0.0, -friction_spring_force(kind, shear, prm) if pen > 0.0 else 0.0)
+    return record_observation(obs, (x, z, vx, vz, shear), (pen, normal, cos_a, pen > 0.0),
+                              (phi, slips, work, dissipated, e_normal),
+                              t, -friction_spring_force(kind, shear, prm) if pen > 0.0 else 0.0)

@@ -1,6 +1,8 @@
 """DOP853: Dormand & Prince's explicit pair of order 8 with error estimators of orders 5
 and 3 (Hairer, Norsett & Wanner, Solving ODEs I, Sec. II.10), the tableau as scipy ships
-it: 12 stages, the 13th rate f(t + h, y1) serving the error estimate, the step's cubic
+it (stored beside this module in ``dop853_tableau.npz``, so that an FMU's first step
+does not import scipy.integrate, a third of a second; a test checks it against scipy's
+to the bit): 12 stages, the 13th rate f(t + h, y1) serving the error estimate, the step's cubic
 Hermite interpolant and the next step's first stage.
 
 Where the motion is not stiff (ringing contact and friction springs, flights, slips: the
@@ -10,6 +12,7 @@ instead of 17 rates and an LU.  Its stability bound is h |lambda| ~ 6 on the neg
 axis; ``stiffness`` is Hairer's estimate of h rho from its last two rates.
 """
 import math
+from pathlib import Path
 
 import numpy as np
 from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator)
@@ -18,13 +21,14 @@ from numba import njit
 from ...layout import P_ATOL, P_RTOL
 from .regimes import NS, NV, rates
 from .workspace import EXPLICIT_STAGES, F0, KX, STAGE
-from scipy.integrate._ivp import dop853_coefficients as _DOP853
 
-EXPLICIT_A = np.ascontiguousarray(_DOP853.A[:EXPLICIT_STAGES, :EXPLICIT_STAGES])
-EXPLICIT_B = np.ascontiguousarray(_DOP853.B)
-EXPLICIT_C = np.ascontiguousarray(_DOP853.C[:EXPLICIT_STAGES])
-EXPLICIT_E5 = np.ascontiguousarray(_DOP853.E5)
-EXPLICIT_E3 = np.ascontiguousarray(_DOP853.E3)
+TABLEAU = Path(__file__).with_name("dop853_tableau.npz")
+with np.load(TABLEAU) as _tableau:
+    EXPLICIT_A = np.ascontiguousarray(_tableau["A"][:EXPLICIT_STAGES, :EXPLICIT_STAGES])
+    EXPLICIT_B = np.ascontiguousarray(_tableau["B"])
+    EXPLICIT_C = np.ascontiguousarray(_tableau["C"][:EXPLICIT_STAGES])
+    EXPLICIT_E5 = np.ascontiguousarray(_tableau["E5"])
+    EXPLICIT_E3 = np.ascontiguousarray(_tableau["E3"])
 
 
 @njit(cache=True)

@@ -507,6 +507,6 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     pz, pv = plate(drv, clock(drv, cnt, n), h)
     pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], pz, pv, prm)
     friction = -friction_spring_force(kind, out[Y_F], prm) if pen > 0.0 else 0.0
-    record_observation(obs, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F], pen, normal, cos_a, out[Y_PHI], slips,
-                       t, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL], pen > 0.0, friction)
+    record_observation(obs, (out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F]), (pen, normal, cos_a, pen > 0.0),
+                       (out[Y_PHI], slips, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL]), t, friction)
     return N_OBS

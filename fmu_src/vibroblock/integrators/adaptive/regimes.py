@@ -108,7 +108,7 @@ def rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
         # The rates are gated on delta > 0; within a contact phase they are continued like
         # the force: gate open, and the normal spring's power, which is linear in delta,
         # scaled from delta = 1 (so that the quadratures' rows of the Jacobian have no kink).
-        work, dissipation, storage = energy_rates(kind, x, vx, vz, t, gate, u_n, u_t, cos_a, sin_a, normal, shear,
+        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, (gate, u_n, u_t, cos_a, sin_a, normal),
                                                   pv, prm)
         out[6], out[7], out[8] = work, dissipation, storage * pen if regime != FLIGHT else 0.0
     else:

@@ -237,7 +237,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     pen = plate_z - out[Y_Z]
     normal = normal_force(kind, pen, out[Y_VZ] - plate_v, prm)
     friction = -friction_spring_force(kind, out[Y_F], prm) if pen > 0.0 else 0.0
-    record_observation(obs, out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F], pen, normal, 1.0, out[Y_PHI], slips,
-                       drv[D_T0] + n * drv[D_DT] + h, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL], pen > 0.0,
-                       friction)
+    record_observation(obs, (out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F]), (pen, normal, 1.0, pen > 0.0),
+                       (out[Y_PHI], slips, out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL]),
+                       drv[D_T0] + n * drv[D_DT] + h, friction)
     return N_OBS
