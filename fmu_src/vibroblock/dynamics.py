@@ -133,10 +133,10 @@ def force(kind, x, t, engaged, penetration, normal, u_t, cos_a, sin_a, shear, pr
 
 
 @njit(inline="always")
-def energy_rates(kind, x, velocity, shear, t, contact_now, plate_v, prm):
+def energy_rates(kind, x, velocity, shear, t, engaged, contact_now, plate_v, prm):
     """Rates of the energy balance at the state (x, ``velocity`` = (vx, vz), shear F) whose
-    contact quantities are ``contact_now`` (``contact``; its penetration only gates the
-    contact's terms): work done on the block by the drive's far end, the
+    contact quantities are ``contact_now`` (``contact``), the contact's terms counted while
+    ``engaged``: work done on the block by the drive's far end, the
     plate and the load; power dissipated by the dashpots; power stored in the normal
     spring (-k_n delta u_n, which is d(k_n delta^2 / 2)/dt on a flat plate).
 
@@ -152,7 +152,7 @@ def energy_rates(kind, x, velocity, shear, t, contact_now, plate_v, prm):
     tangential = -prm[P_GT] * u_t
     dissipation = prm[P_GT] * u_t * u_t
     storage = 0.0
-    if penetration > 0.0:
+    if engaged:
         tangential -= friction_spring_force(kind, shear, prm)
         dissipation += contact_dissipation(kind, penetration, u_n, prm)
         storage = -contact_elastic(kind, penetration, prm) * u_n

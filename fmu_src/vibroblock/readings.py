@@ -9,7 +9,7 @@ dispatch read their bits at run time.  (Given a numba literal instead, they fold
 constants.)  The defaults (every choice 0) are the variant's index alone.
 
 ``kind`` = variant index (bits 0-2) | TANGENT_FRAME | FREE_FLIGHT | the laws' bits
-(``laws.AXES``: the Coulomb bound bit 4, the contact law bits 6-7, ...).
+(``laws.AXES``: the contact law bits 6-7, the Coulomb bound bits 10-11, ...).
 """
 from __future__ import annotations
 

@@ -119,8 +119,10 @@ def _event_driven_refuses(readings: dict) -> str | None:
     """event_driven's flows are closed forms of linear oscillators and its Coulomb resets are
     zeros of the oscillating contact force: it runs a contact law only if the law says it is
     linear (a module constant ``LINEAR``), and the contact force's bound only."""
-    if readings["coulomb_normal"] == 1:
-        return "locates Coulomb resets on the oscillating contact force only, not coulomb_normal = 1 (applied_load)"
+    if readings["coulomb_normal"] != 0:
+        bound = law("bound", readings["coulomb_normal"])
+        return (f"locates Coulomb resets on the oscillating contact force only, not coulomb_normal = {bound.id} "
+                f"({bound.name})")
     contact = law("contact", readings.get("contact_law", 0))
     if not getattr(contact.module, "LINEAR", False):
         return (f"integrates the closed-form flows of a linear contact law only, not contact_law = {contact.id} "

@@ -29,7 +29,7 @@ def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
     dv = rate_x - prm[P_VD]
     work = dissipation = storage = 0.0
     if track_energy:
-        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, (pen, u_n, u_t, cos_a, sin_a, normal),
+        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, pen > 0.0, (pen, u_n, u_t, cos_a, sin_a, normal),
                                                   plate_v, prm)
     return rate_x, rate_z, fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv, work, dissipation, storage
 

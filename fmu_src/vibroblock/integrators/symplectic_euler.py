@@ -32,7 +32,7 @@ def euler_step(kind, prm, state, t, h, contact_now, plate, track_energy):
     fx, fz = force(kind, x, t, pen > 0.0, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_work = d_dissipated = d_normal = 0.0
     if track_energy:
-        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, contact_now, plate_v, prm)
+        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, pen > 0.0, contact_now, plate_v, prm)
         d_work, d_dissipated, d_normal = h * work, h * dissipation, h * storage
     engaged = pen > 0.0
     vx += h_over_m * fx

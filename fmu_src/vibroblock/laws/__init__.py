@@ -53,12 +53,12 @@ class Axis:
 
 
 # Bits 0-2 of kind hold the variant, 3 and 5 the readings formulation and flight
-# (vibroblock.readings); the Coulomb bound keeps bit 4, where it was a reading.
+# (vibroblock.readings); bit 4 is free (the Coulomb bound's while it had two values).
 AXES = {
     "contact": Axis("contact", "contact_law", "contact_", 6, 2),
     "friction": Axis("friction", "friction_law", "friction_", 8, 2),
-    "bound": Axis("bound", "coulomb_normal", "bound_", 4, 1),
-    "plate": Axis("plate", "plate_motion", "plate_", 10, 0),
+    "bound": Axis("bound", "coulomb_normal", "bound_", 10, 2),
+    "plate": Axis("plate", "plate_motion", "plate_", 12, 0),
 }
 
 

@@ -105,12 +105,11 @@ def rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
     drift = rate_x - prm[P_VD]
     out[5] = drift * drift
     if track_energy:
-        # The rates are gated on delta > 0; within a contact phase they are continued like
-        # the force: gate open, and the normal spring's power, which is linear in delta,
-        # scaled from delta = 1 (so that the quadratures' rows of the Jacobian have no kink).
-        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, (gate, u_n, u_t, cos_a, sin_a, normal),
-                                                  pv, prm)
-        out[6], out[7], out[8] = work, dissipation, storage * pen if regime != FLIGHT else 0.0
+        # Within a contact phase the rates are continued across delta = 0 like the force
+        # (so that the quadratures' rows of the Jacobian have no kink): the gate is the regime.
+        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, gate > 0.0,
+                                                  (pen, u_n, u_t, cos_a, sin_a, normal), pv, prm)
+        out[6], out[7], out[8] = work, dissipation, storage
     else:
         out[6] = out[7] = out[8] = 0.0
 
