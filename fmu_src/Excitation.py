@@ -129,30 +129,32 @@ class ExcitationFacade(FmuFacade):
                                   f"({Path.cwd()}), or leave it empty for the bundled record")
         self.seismic_record = str(path)
 
-    def _seismic_playback(self) -> Playback:
-        """The seismic record_file processed to SI (harness.ground.records, bundled)."""
+    def _seismic_playback(self, path: str | None = None, inventory: str | None = None) -> Playback:
+        """The seismic record_file (or ``path``, with ``inventory``) processed to SI
+        (harness.ground.records, bundled)."""
+        path = self.seismic_record if path is None else path
+        inventory = self.record_inventory if inventory is None else inventory
         try:
             from vibroblock_records import RecordError, load_ground_motion
         except ImportError:  # a process that has the harness: the same package
             try:
                 from harness.ground.records import RecordError, load_ground_motion
             except ImportError as exc:
-                raise ExcitationError(f"record_file = {self.seismic_record!r} is a seismic record, which needs obspy "
+                raise ExcitationError(f"record_file = {path!r} is a seismic record, which needs obspy "
                                       f"in the FMU's Python environment ({exc}); install it (pip install obspy) or "
                                       "convert the record with 'vibroblock record FILE --save-record record.npz'") \
                     from None
         try:
-            motion = load_ground_motion(self.seismic_record, inventory=self.record_inventory or None)
+            motion = load_ground_motion(path, inventory=inventory or None)
         except RecordError as exc:
             if "no instrument response" in str(exc):
                 raise ExcitationError(
-                    f"record_file = {self.seismic_record!r} holds counts without an instrument response, which have "
+                    f"record_file = {path!r} holds counts without an instrument response, which have "
                     "no physical meaning: set record_inventory to its StationXML, RESP or dataless SEED file, or "
                     "convert it with 'vibroblock record FILE --sensitivity COUNTS_PER_UNIT --quantity Q --unit U "
                     "--save-record record.npz' and play that") from None
-            raise ExcitationError(f"record_file = {self.seismic_record!r}: {exc}") from None
-        return Playback(motion.acceleration, motion.dt, motion.velocity[0], motion.displacement[0],
-                        source=self.seismic_record)
+            raise ExcitationError(f"record_file = {path!r}: {exc}") from None
+        return Playback(motion.acceleration, motion.dt, motion.velocity[0], motion.displacement[0], source=path)
 
     # ------------------------------------------------------------------ facade hooks
     def _changed(self) -> None:
@@ -180,11 +182,22 @@ class ExcitationFacade(FmuFacade):
 
     # pythonfmu's default would capture the registered scalars only, not the clock.
     def _capture(self) -> dict:
-        return {"plate": self.plate.get_state(), "start_time": self.start_time}
+        return {"plate": self.plate.get_state(), "start_time": self.start_time,
+                "seismic_record": self.seismic_record, "record_inventory": self.record_inventory}
 
     def _restore(self, state: dict) -> None:
-        plate = Plate.from_state(state["plate"], known=self.plate.record, bundled=self.bundled)
+        known = self.plate.record
+        seismic, inventory = str(state.get("seismic_record", "")), str(state.get("record_inventory", ""))
+        if seismic and state["plate"]["record_digest"] != getattr(known, "digest", None):
+            # A seismic record is known by its processed samples: process it again (a fresh
+            # instance has not read it yet) and check that it is the same.
+            known = self._seismic_playback(seismic, inventory)
+            if known.digest != state["plate"]["record_digest"]:
+                raise ExcitationError(f"the record file {seismic!r} (or its inventory) changed since the state was "
+                                      "saved")
+        plate = Plate.from_state(state["plate"], known=known, bundled=self.bundled)
         self.start_time = float(state["start_time"])
+        self.seismic_record, self.record_inventory = seismic, inventory
         self.plate = plate
 
 

@@ -101,3 +101,48 @@ def test_the_excitation_fmu_plays_a_miniseed_record_with_its_response_in_fmpy(qu
     errors = [line for line in done.stdout.splitlines() if line.startswith("[ERROR]")]
     assert len(errors) == 1 and "holds counts without an instrument response" in errors[0]
     assert "set record_inventory" in errors[0] and "raised:" in done.stdout
+
+
+def test_the_excitation_fmu_restores_a_seismic_record_s_state_in_a_new_instance(quick_fmus, tmp_path):
+    """A serialized state of an instance playing a MiniSEED record (counts, with its
+    StationXML) continues bit for bit in a fresh instance that never read the record."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    fmu = str(quick_fmus / "Excitation.fmu")
+    md, unzipped = read_model_description(fmu), extract(fmu, unzipdir=str(tmp_path / "x"))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+
+    def instance(name):
+        slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                          instanceName=name)
+        slave.instantiate()
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        return slave
+
+    def play(slave, t, steps):
+        samples = []
+        for _ in range(steps):
+            slave.doStep(t, 7.0)  # fmpy raises on an error status
+            t += 7.0
+            samples.append(tuple(slave.getReal([vr["plate_z"], vr["plate_v"], vr["plate_a"]])))
+        return samples
+
+    first = instance("first")
+    first.setInteger([vr["mode"]], [4])
+    first.setString([vr["record_file"], vr["record_inventory"]], [str(ULN_RECORD), str(ULN_INVENTORY)])
+    first.exitInitializationMode()
+    play(first, 0.0, 100)
+    serialized = first.serializeFMUstate(first.getFMUstate())
+    reference = play(first, 700.0, 100)
+    first.terminate()
+    first.freeInstance()
+
+    fresh = instance("fresh")  # harmonic, no record, until restored
+    fresh.exitInitializationMode()
+    fresh.setFMUstate(fresh.deSerializeFMUstate(serialized))
+    assert fresh.getString([vr["record_file"]])[0].decode() == str(ULN_RECORD)
+    assert play(fresh, 700.0, 100) == reference
+    fresh.terminate()
+    fresh.freeInstance()
