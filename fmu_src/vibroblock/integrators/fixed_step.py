@@ -24,19 +24,17 @@ The driver owns everything else: the grid and the plate drive, the friction rule
 the quadratures at the end of every step (``settle``), the counters, the finite-state
 checks, and leaving the arrays untouched on failure (the contract in ``__init__``).
 Which scheme runs is a compile-time constant (``method``, a literal): the step is
-inlined into the loop (``scheme_step``), and the loop reads the parameters as a tuple,
-so it costs what a hand-written one would.
+inlined into the loop, so the loop costs what a hand-written one would.
 """
 import math
 
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import literally, njit, types
 from numba.extending import overload
-from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from ..dynamics import contact, coulomb_bound, friction_rule
 from ..laws import friction_released, friction_spring_force
-from ..layout import (N_PRM, C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
+from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
                       Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .plate import drive_sin_cos, next_sin_cos, phase_after, plate_after, plate_at, plate_moves
@@ -55,30 +53,23 @@ def scheme_prepare(method):
     """The ``prepare`` of scheme ``method`` (compiled code only)."""
 
 
-def scheme_step(method, kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
-    """One step of scheme ``method`` (compiled code only)."""
+def scheme_step(method):
+    """The ``step`` of scheme ``method`` (compiled code only)."""
 
 
-@overload(scheme_prepare)
-def _scheme_prepare(method):
-    if isinstance(method, types.IntegerLiteral):
-        prepare = SCHEMES[method.literal_value][0]
-        return lambda method: prepare
-    return None
+def _scheme_part(index):
+    """Typing of ``scheme_prepare`` (index 0) or ``scheme_step`` (1): the registered
+    scheme's function for a literal method."""
+    def typer(method):
+        if isinstance(method, types.IntegerLiteral):
+            part = SCHEMES[method.literal_value][index]
+            return lambda method: part
+        return None
+    return typer
 
 
-@overload(scheme_step, inline="always")
-def _scheme_step(method, kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
-    # Inlined with the scheme's own step (an inline="always" function the overload's body
-    # calls): LLVM would call a step held in a variable as a function once it grows past
-    # its inlining threshold, which costs the loop 3x in argument passing and reference counts.
-    if isinstance(method, types.IntegerLiteral):
-        step = SCHEMES[method.literal_value][1]
-
-        def run(method, kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
-            return step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy)
-        return run
-    return None
+overload(scheme_prepare)(_scheme_part(0))
+overload(scheme_step)(_scheme_part(1))
 
 
 @njit(inline="always")
@@ -145,10 +136,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     scene's guard stopped before a step; the steps taken so far are stored) or a
     negative failure code (the arrays are left as they were on entry)."""
     method = literally(method)
-    prepare = scheme_prepare(method)
-    # The parameters as a tuple of floats: an array handed through the inlined law and
-    # model functions costs atomic reference counts inside the loop.
-    prm = to_fixed_tuple(prm, N_PRM)
+    prepare, step = scheme_prepare(method), scheme_step(method)
     t0, dt = drv[D_T0], drv[D_DT]
     ctx = prepare(kind, flags, drv, prm, dt)
     moving = plate_moves(drv)
@@ -174,7 +162,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
         else:
             pzh, pvh, pz1, pv1 = pz0, pv0, pz0, pv0
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
-         d_normal) = scheme_step(method, kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), contact0, (t, dt, t1 - t),
+         d_normal) = step(kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), contact0, (t, dt, t1 - t),
                           (pz0, pv0, pzh, pvh, pz1, pv1, s, c), track_energy)
         if status != OK:
             if status < 0:
@@ -209,7 +197,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     the stored trajectory stays on the grid, independent of the communication steps.
     A scratch step that fails leaves the grid state (with the plate at t_n + h)."""
     method = literally(method)
-    prepare = scheme_prepare(method)
+    prepare, step = scheme_prepare(method), scheme_step(method)
     t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, slips = y[Y_PHI], cnt[C_SLIPS]
@@ -224,7 +212,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
         s1, c1 = math.sin(phase1), math.cos(phase1)
         pz1, pv1 = plate_at(drv, s1, c1, t + h)
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
-         d_normal) = scheme_step(method, kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), state_contact, (t, h, h),
+         d_normal) = step(kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), state_contact, (t, h, h),
                           (pz0, pv0, pzh, pvh, pz1, pv1, s1, c1), track_energy)
         if status == OK:
             x, z, vx, vz, shear = x1, z1, vx1, vz1, shear1

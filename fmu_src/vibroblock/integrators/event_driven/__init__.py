@@ -74,11 +74,10 @@ import math
 import numpy as np
 from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
-from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from ...dynamics import normal_force, plate_motion
 from ...laws import friction_spring_force
-from ...layout import (N_PRM, C_EVENTS, C_JUMPED, C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V,
+from ...layout import (C_EVENTS, C_JUMPED, C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V,
                        D_EXT_Z, D_OMEGA, D_T0, N_OBS, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X,
                        Y_Z)
 from ..fixed_step import record_observation
@@ -209,9 +208,7 @@ def advance_exact(kind, y, cnt, drv, prm, n_steps, track_energy, tol, skip_perio
     n = cnt[C_STEP]
     out = y.copy()
     costs = np.zeros(2, np.int64)
-    # The parameters as a tuple of floats, as adaptive's: no reference counts in the segments.
-    parameters = to_fixed_tuple(prm, N_PRM)
-    slips = _evolve(kind, out, cnt[C_SLIPS], drv, parameters, (cnt[C_PHASE_STEP], n, 0.0, n + n_steps, 0.0),
+    slips = _evolve(kind, out, cnt[C_SLIPS], drv, prm, (cnt[C_PHASE_STEP], n, 0.0, n + n_steps, 0.0),
                     (track_energy, tol, skip_periods), costs)
     if slips < 0:
         return -1
