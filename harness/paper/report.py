@@ -40,10 +40,18 @@ def reading_rows(studies: dict[str, Study]) -> dict[str, dict]:
     return table
 
 
+def flips(verdicts) -> bool:
+    """A verdict flips with the reading when some readings agree with the paper and others
+    do not (disagrees and not reproduced under two readings is no flip: neither agrees)."""
+    verdicts = set(verdicts)
+    return AGREES in verdicts and len(verdicts) > 1
+
+
 def claim_rows(studies: dict[str, Study]) -> list[Row]:
     """Every row of the claims table, from the studies' measured values under the default
-    reading; a part whose verdict differs under another reading gets the verdict FLIPS
-    and a reason that names the verdict of each reading."""
+    reading; a part that agrees under some readings and not under others gets the verdict
+    FLIPS, one that agrees under none gets the worst of its verdicts (disagrees before not
+    reproduced), each with a reason that names the verdict of each reading."""
     by_reading = reading_rows(studies)
     rows: list[Row] = []
     for name, claim in CLAIMS.items():
@@ -54,7 +62,8 @@ def claim_rows(studies: dict[str, Study]) -> list[Row]:
             if len(set(verdicts.values())) > 1:
                 row.reason = ("; ".join(f"{r.label}: {v}" for r, v in verdicts.items())
                               + f". Under the default reading ({DEFAULT_READING.label}): {row.reason}")
-                row.verdict = FLIPS
+                row.verdict = FLIPS if flips(verdicts.values()) else (
+                    DISAGREES if DISAGREES in verdicts.values() else NOT_REPRODUCED)
             rows.append(row)
     return rows
 
@@ -96,7 +105,7 @@ def reading_summary(studies: dict[str, Study]) -> list[str]:
         agreeing = [part for part in parts if table[part][reading].verdict == AGREES]
         lines.append(f"{reading.label}: agrees on {len(agreeing)} of {len(parts)} parts"
                      + (f" ({', '.join(agreeing)})" if agreeing else ""))
-    flipping = [part for part, per_part in table.items() if len({row.verdict for row in per_part.values()}) > 1]
+    flipping = [part for part, per_part in table.items() if flips(row.verdict for row in per_part.values())]
     lines.append("verdict flips with the reading: " + (", ".join(flipping) if flipping else "none"))
     return lines
 

@@ -7,8 +7,9 @@ Verdicts are computed from the numbers a study measured, never written by hand:
 * ``not reproduced``: the study could not measure what the criterion needs (e.g. no
   transition in the scanned range, no complete slip in the window);
 * ``flips with the reading``: the claim was measured under several readings of the
-  paper's equations (:mod:`.readings`) and its verdict is not the same under all of them
-  (the report gives each).
+  paper's equations (:mod:`.readings`) and it agrees under some of them and not under
+  others (the report gives each); where it agrees under none, the verdict is the worse
+  one (``disagrees`` before ``not reproduced``).
 
 Each claim's module states its criteria; the tolerances several claims use are here.
 """

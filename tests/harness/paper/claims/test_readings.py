@@ -10,7 +10,7 @@ from harness.paper import report
 from harness.paper.claims import CLAIMS, READINGS, Runner, Study, run_studies, study_name
 from harness.paper.claims.readings import (A_READINGS, DEFAULT_READING, Reading, split_study_name)
 from harness.paper.claims.study import CORRUGATED_TOLERANCES, RESOLUTIONS
-from harness.paper.claims.verdicts import AGREES, FLIPS, NOT_REPRODUCED
+from harness.paper.claims.verdicts import AGREES, DISAGREES, FLIPS, NOT_REPRODUCED
 
 
 @pytest.fixture
@@ -152,5 +152,12 @@ def test_a_verdict_that_differs_between_readings_is_reported_as_flipping():
     assert f"{tangent.label}: agrees on 0 of 1 parts" in text
     assert f"{DEFAULT_READING.label}: agrees on 1 of 1 parts (C7)" in text
     assert "verdict flips with the reading: C7" in text
+    # Two readings that both fail the claim, in different ways: no flip, the worse verdict.
+    disagrees = _c7([1.0, 0.5, 0.5])
+    assert next(r for r in report.claim_rows(same) if r.claim == "C7").verdict == AGREES
+    both_fail = {**{study_name("C7", r): disagrees for r in READINGS}, study_name("C7", tangent): never_leaves}
+    row = next(r for r in report.claim_rows(both_fail) if r.claim == "C7")
+    assert row.verdict == DISAGREES and f"{tangent.label}: {NOT_REPRODUCED}" in row.reason
+    assert "verdict flips with the reading: none" in report.markdown(both_fail)
     # One reading alone: no side-by-side section and the plain verdict.
     assert "side by side" not in report.markdown({"C7": leaves_and_returns})
