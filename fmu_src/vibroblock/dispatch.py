@@ -32,7 +32,7 @@ def by_kind(functions: dict, selector: str, arguments: str, takes_kind: bool = F
         lines.append("    return result")
     exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registries' integer keys only
     # Inlined into its callers: a call of a separately compiled function would pass its
-    # arrays with a reference count taken and dropped per call, which costs the fixed-step
-    # kernels up to 4x.  (numba's SSA check then warns that the branches' shared result
+    # arrays with a reference count taken and dropped per call (where a kernel has not
+    # taken their data pointers, ``unowned``), which cost the fixed-step kernels up to 4x.  (numba's SSA check then warns that the branches' shared result
     # is "not in scope"; it is a pedantic warning of numba's own, filtered in jitcache.)
     return njit(inline="always")(namespace["dispatch"])

@@ -45,6 +45,7 @@ from .integrators.plate import drive_sin_cos, phase_after, plate_after, plate_at
 from .layout import (C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_OMEGA, D_T0, P_G, P_GN, P_GT, P_KD, P_KN, P_M,
                      P_MUS, P_VD, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .models import frame, load, profile
+from .unowned import data_pointer
 
 RIGID, FROZEN, COULOMB = 1, 2, 4
 # The id of this scheme in the integrator registry (internal: chosen by the scene options).
@@ -208,6 +209,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     """``fixed_step.observe`` for a reduced block: the state at t_n + h (one scratch step
     from the grid state), and the contact state, normal and friction forces acting there
     (those of a step of dt starting at that state)."""
+    prm, drv, cnt = data_pointer(prm), data_pointer(drv), data_pointer(cnt)
     dt = drv[D_DT]
     rigid, coulomb = (flags & RIGID) != 0, (flags & COULOMB) != 0
     r_re, r_im = orbit_response(prm, drv[D_AMP], drv[D_OMEGA])

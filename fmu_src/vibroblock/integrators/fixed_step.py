@@ -23,8 +23,10 @@ smallest example):
 The driver owns everything else: the grid and the plate drive, the friction rule and
 the quadratures at the end of every step (``settle``), the counters, the finite-state
 checks, and leaving the arrays untouched on failure (the contract in ``__init__``).
-Which scheme runs is a compile-time constant (``method``, a literal): the step is
-inlined into the loop, so the loop costs what a hand-written one would.
+Which scheme runs is a compile-time constant (``method``, a literal), and the loop reads
+the parameter, drive and counter arrays through their data pointers (``unowned``): with
+no reference counts left in it, LLVM inlines the step into the loop, which then costs
+what a hand-written one would.
 """
 import math
 
@@ -34,6 +36,7 @@ from numba.extending import overload
 
 from ..dynamics import contact, coulomb_bound, friction_rule
 from ..laws import friction_released, friction_spring_force
+from ..unowned import data_pointer
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
                       Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
@@ -137,6 +140,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     negative failure code (the arrays are left as they were on entry)."""
     method = literally(method)
     prepare, step = scheme_prepare(method), scheme_step(method)
+    prm, drv, cnt = data_pointer(prm), data_pointer(drv), data_pointer(cnt)
     t0, dt = drv[D_T0], drv[D_DT]
     ctx = prepare(kind, flags, drv, prm, dt)
     moving = plate_moves(drv)
@@ -198,6 +202,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     A scratch step that fails leaves the grid state (with the plate at t_n + h)."""
     method = literally(method)
     prepare, step = scheme_prepare(method), scheme_step(method)
+    prm, drv, cnt = data_pointer(prm), data_pointer(drv), data_pointer(cnt)
     t = drv[D_T0] + cnt[C_STEP] * drv[D_DT]
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     phi, slips = y[Y_PHI], cnt[C_SLIPS]

@@ -18,6 +18,7 @@ from numba import njit
 
 from ...dynamics import contact
 from ...laws import friction_energy, friction_spring_force
+from ...unowned import data_pointer
 from ...layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
                        D_EXT_A, D_EXT_V, D_EXT_Z, D_OMEGA, D_T0, N_OBS, P_MAX_JUMP, P_RTOL, Y_DISSIPATED,
                        Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
@@ -435,6 +436,7 @@ def evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     """Integrate from grid step n0 (state y) over local time u_end.  Writes the final state
     to ``out`` (layout of y), the slip count to costs[0] and the cost counters (accepted,
     rejected, events, Jacobians, periods jumped) to costs[1:6].  Returns OK or a negative status."""
+    drv, prm = data_pointer(drv), data_pointer(prm)
     run = (kind, drv, prm, track_energy)
     clk = clock(drv, cnt, n0)
     ws = workspace()

@@ -77,6 +77,7 @@ from numba import njit
 
 from ...dynamics import normal_force, plate_motion
 from ...laws import friction_spring_force
+from ...unowned import data_pointer
 from ...layout import (C_EVENTS, C_JUMPED, C_PHASE_STEP, C_SLIPS, C_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V,
                        D_EXT_Z, D_OMEGA, D_T0, N_OBS, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_VX, Y_VZ, Y_WORK, Y_X,
                        Y_Z)
@@ -125,6 +126,7 @@ def _evolve(kind, s, slips, drv, prm, window, options, costs):
     """
     anchor, n_ref, off, n_to, off_to = window
     track_energy, tol, skip_periods = options
+    drv, prm = data_pointer(drv), data_pointer(prm)
     dt, om = drv[D_DT], drv[D_OMEGA]
     ext_origin = drv[D_T0] - drv[D_EXT_T]
     consts = contact_constants(prm, drv)

@@ -1,0 +1,36 @@
+"""The kernels' raw view of their run arrays (``vibroblock.unowned``)."""
+import numpy as np
+import pytest
+from numba import njit
+from numba.core.errors import TypingError
+
+from vibroblock.unowned import data_pointer
+
+
+@njit
+def _sum_and_bump(values, counts):
+    """Reads ``values`` and increments ``counts`` through their data pointers."""
+    v, c = data_pointer(values), data_pointer(counts)
+    total = 0.0
+    for i in range(values.size):
+        total += v[i]
+        c[i] += 1
+    return total
+
+
+def test_the_pointer_reads_and_writes_the_arrays_own_data():
+    values = np.array([0.5, 1.25, -3.0, 1e300])
+    counts = np.array([7, 0, -2, 5], dtype=np.int64)
+    assert _sum_and_bump(values, counts) == values.sum()
+    assert counts.tolist() == [8, 1, -1, 6]
+
+
+@njit
+def _first(values):
+    return data_pointer(values)[0]
+
+
+def test_a_strided_array_is_refused_at_compile_time():
+    """A pointer to a view's data would read the base array's elements, not the view's."""
+    with pytest.raises(TypingError):
+        _first(np.arange(6.0)[::2])
