@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 from . import layout as L
+from .laws import law
 from .models import frame
 from .orbits import steady_orbit
 from .settings import ModelError, Settings
@@ -30,23 +31,35 @@ def place(settings: Settings, prm, drv, y) -> bool:
         _place_in_tangent_frame(settings, prm, y, weight, phase)
         return _place_for_scene(settings, prm, drv, y)
     if settings.initial_state == 0:
-        y[L.Y_Z] = plate_z - weight / (p["k_n"] * cos_a)
+        y[L.Y_Z] = plate_z - weight / (_contact_at_rest(settings, weight)[0] * cos_a)
         y[L.Y_VZ] = p["vz_start"]
     elif settings.initial_state == 1:
         y[L.Y_Z], y[L.Y_VZ] = p["z_start"], p["vz_start"]
     else:
-        offset, rate = _steady_orbit(p, weight, phase)
+        offset, rate = _steady_orbit(settings, weight, phase)
         y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
     return _place_for_scene(settings, prm, drv, y)
 
 
-def _steady_orbit(p, weight, phase):
-    """``orbits.steady_orbit`` for the run's parameters; a drive that has none is refused."""
+def _contact_at_rest(settings: Settings, weight: float) -> tuple[float, float, float]:
+    """The run's contact law at rest under ``weight``: (secant stiffness, tangent
+    stiffness, damping); the rest penetration is weight / secant (k_n for the linear laws)."""
+    return law("contact", settings.readings["contact_law"]).module.rest(weight, settings.parameters)
+
+
+def _steady_orbit(settings: Settings, weight, phase):
+    """``orbits.steady_orbit`` for the run's parameters, about the contact's rest
+    penetration; a nonlinear contact's orbit is its linearisation's there (a start close
+    to the orbit, whose transient the contact's damping removes).  A drive that has none
+    is refused."""
+    p = settings.parameters
+    secant, stiffness, damping = _contact_at_rest(settings, weight)
     try:
-        return steady_orbit(p["m"], p["k_n"], p["gamma_n"], weight, p["A"], p["omega"], phase)
+        oscillation, rate = steady_orbit(p["m"], stiffness, damping, 0.0, p["A"], p["omega"], phase)
     except ValueError as exc:
         raise ModelError(f"initial_state = 2 (steady_orbit): {exc}; start at rest or as given "
                          f"(initial_state = 0 or 1), or give the contact some damping") from None
+    return -weight / secant + oscillation, rate
 
 
 def point_to_frame(variant, prm, x, z, vx, vz):
@@ -76,12 +89,12 @@ def _place_in_tangent_frame(settings: Settings, prm, y, weight, phase) -> None:
     plate_p, plate_v = p["A"] * math.sin(phase), p["A"] * p["omega"] * math.cos(phase)
     zeta, u, w = point_to_frame(variant, prm, x, p["z_start"], p["vx_start"], p["vz_start"])
     if settings.initial_state == 0:
-        zeta = plate_p - weight / p["k_n"]
+        zeta = plate_p - weight / _contact_at_rest(settings, weight)[0]
         height, slope = variant.profile(x, prm)
         z = height + zeta * math.sqrt(1.0 + slope * slope)  # h + zeta / cos a
         _, u, w = point_to_frame(variant, prm, x, z, p["vx_start"], p["vz_start"])
     elif settings.initial_state == 2:
-        offset, rate = _steady_orbit(p, weight, phase)
+        offset, rate = _steady_orbit(settings, weight, phase)
         zeta, w = plate_p + offset, plate_v + rate
     y[L.Y_Z], y[L.Y_VX], y[L.Y_VZ] = zeta, u, w
 
@@ -96,7 +109,7 @@ def _place_for_scene(settings: Settings, prm, drv, y) -> bool:
         height, slope = settings.variant.profile(y[L.Y_X], prm)
         y[L.Y_Z], y[L.Y_VZ] = plate_z + height, plate_v + slope * y[L.Y_VX]
     if settings.scene["frozen_vertical"]:
-        offset, rate = _steady_orbit(p, p["m"] * p["g"], phase)
+        offset, rate = _steady_orbit(settings, p["m"] * p["g"], phase)
         if offset >= 0.0:
             return False
         y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate

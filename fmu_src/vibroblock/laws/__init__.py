@@ -15,7 +15,9 @@ axis          parameter         functions
 contact       ``contact_law``   force(delta, u_n, prm), elastic(delta, prm), dissipation(delta,
                                 u_n, prm), potential(delta, prm); CONSERVATIVE: the elastic
                                 force is -grad(potential) on a curved plate; LINEAR: the
-                                force is linear in (delta, u_n) (event_driven needs it)
+                                force is linear in (delta, u_n) (event_driven needs it);
+                                in Python: rest(load, p) -> (secant stiffness, tangent
+                                stiffness, damping) at rest under the load (the start)
 friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F0, F1, prm),
                                 rule(F, delta, N_b, prm)
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N

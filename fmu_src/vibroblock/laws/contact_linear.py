@@ -40,3 +40,9 @@ def dissipation(penetration, u_n, prm):
 def potential(penetration, prm):
     """U = k_n delta^2 / 2 (delta > 0; the caller gates it)."""
     return 0.5 * prm[P_KN] * penetration * penetration
+
+
+def rest(load: float, p: dict) -> tuple[float, float, float]:
+    """The contact at rest under ``load`` (``vibroblock.initial_state``): secant and
+    tangent stiffness k_n (rest penetration load / k_n) and damping gamma_n."""
+    return p["k_n"], p["k_n"], p["gamma_n"]

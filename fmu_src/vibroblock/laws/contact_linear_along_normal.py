@@ -19,3 +19,4 @@ force = contact_linear.force
 elastic = contact_linear.elastic
 dissipation = contact_linear.dissipation
 potential = contact_linear.potential  # the energy the balance books (its defect shows in the residual)
+rest = contact_linear.rest

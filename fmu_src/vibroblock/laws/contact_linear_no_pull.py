@@ -15,7 +15,7 @@ from numba.extending import overload
 from . import contact_linear
 # The spring is the paper's: the same potential and elastic force (and so delta_0 and the
 # curvature term); only the total force is clipped.
-from .contact_linear import elastic, potential  # noqa: F401  (this law's functions too)
+from .contact_linear import elastic, potential, rest  # noqa: F401  (this law's functions too)
 
 ID = 2
 LINEAR = False  # the clip is a kink: event_driven's closed-form flows do not hold
@@ -26,7 +26,8 @@ REFUSED_BY = {
 
 
 def at_least_zero(value):
-    """max(value, 0) (compiled code only)."""
+    """max(value, 0)."""
+    return max(value, 0.0)
 
 
 @overload(at_least_zero, inline="always")
