@@ -24,6 +24,9 @@ from .records import RecordError
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}  # model A's scaled stick-slip set (harness.runs.settings)
 OUTPUTS = ("x", "z", "vx", "normal_force", "contact", "coulomb_resets")
+# The run keeps its input table and outputs in memory (fmpy), ~0.2 kB a communication step:
+# beyond this many steps (~0.4 GB, a few minutes) the command asks for a shorter run instead.
+MAX_STEPS = 2_000_000
 # What each printed number means.
 MEANINGS = {
     "peak_plate_acceleration_g": "largest |plate acceleration|, in the block's g (> 1: the plate can throw it)",
@@ -108,6 +111,13 @@ def run_record(settings: RecordRun, show_plot: bool = False) -> dict:
     if stop < step:
         raise RecordError(f"the run would be shorter than one communication step ({step:g} tau_0); give a stop "
                           f"time >= {step:g} tau_0 or a smaller --step")
+    steps = round(stop / step)
+    if steps > MAX_STEPS:
+        raise RecordError(
+            f"the run would take {steps:.3g} communication steps ({stop:.6g} tau_0 = {stop / time_scale:.4g} s of the "
+            f"record at {step:g} tau_0 a step), more than the {MAX_STEPS:.0e} this command holds in memory; give "
+            f"--stop-time {MAX_STEPS * step:g} or less, a larger --step, or play the record faster "
+            f"(--time-stretch {settings.time_stretch * MAX_STEPS / steps:.2g} or less)")
     notes = []
     if stop < duration - step:
         notes.append(f"the run ({stop:g} tau_0 = {stop / time_scale:.4g} s of the record) is shorter than the "

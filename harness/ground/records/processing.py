@@ -108,7 +108,8 @@ class ProcessingSettings:
             raise RecordError(f"freqmin={self.freqmin!r} Hz must be positive")
         if self.freqmax is not None and not (self.freqmax > self.freqmin):
             raise RecordError(
-                f"freqmax={self.freqmax!r} Hz must be above freqmin={self.freqmin!r} Hz"
+                f"freqmax={self.freqmax!r} Hz must be above freqmin={self.freqmin!r} Hz; "
+                "raise freqmax or lower freqmin"
             )
         if int(self.corners) != self.corners or not 1 <= self.corners <= 10:
             raise RecordError(f"corners={self.corners!r} must be an integer from 1 to 10")
@@ -134,6 +135,14 @@ class ProcessingSettings:
     def resolved(self, sampling_rate: float) -> "ProcessingSettings":
         """Copy with ``freqmax`` and ``pad_seconds`` filled in for a record."""
         freqmax = 0.4 * sampling_rate if self.freqmax is None else float(self.freqmax)
+        if self.freqmax is None and not freqmax > self.freqmin:
+            # A long-period record (e.g. a 1 Hz LH channel) has no band above the default
+            # high-pass corner: say which corner to move, and to where.
+            raise RecordError(
+                f"freqmin={self.freqmin:g} Hz is not below this record's default low-pass corner "
+                f"freqmax={freqmax:g} Hz (0.4 x its sampling rate of {sampling_rate:g} Hz); "
+                f"lower freqmin (--freqmin), e.g. to {freqmax / 10:.2g} Hz"
+            )
         pad = 0.75 * self.corners / self.freqmin if self.pad_seconds is None else self.pad_seconds
         return replace(self, freqmax=freqmax, pad_seconds=float(pad))
 

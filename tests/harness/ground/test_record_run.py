@@ -54,6 +54,18 @@ def test_a_miniseed_record_with_its_stationxml_runs_and_plays_in_the_excitation_
     assert np.any(played["plate_z"] != 0.0) and np.all(np.isfinite(played["plate_a"]))
 
 
+def test_a_record_too_long_to_play_whole_asks_for_a_shorter_run(quick_fmus, subprocess_env):
+    """The ULN record (1.11e4 s at 1 Hz) at its own pace is 3.5e6 tau_0 of a 1 kg block on
+    1e5 N/m: 1.4e7 communication steps, which would hold gigabytes.  One line, exit status 2,
+    naming the count and the three ways out."""
+    refused = record([ULN_RECORD, "--inventory", ULN_INVENTORY, "--fmu", quick_fmus / "BlockA.fmu", "--freqmin",
+                      "0.02"], subprocess_env, timeout=300)
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    [line] = refused.stderr.strip().splitlines()
+    assert line.startswith("vibroblock record: error: the run would take 1.4e+07 communication steps")
+    assert "--stop-time 500000 or less" in line and "--step" in line and "--time-stretch 0.14 or less" in line
+
+
 def result_samples(printed: str) -> int:
     line = next(line for line in printed.splitlines() if line.startswith("record: "))
     return int(line.split("), ", 1)[1].split(" samples")[0])

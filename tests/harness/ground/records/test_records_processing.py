@@ -200,6 +200,16 @@ def test_invalid_settings_are_refused(kwargs, message):
         ProcessingSettings(**kwargs)
 
 
+def test_a_long_period_record_below_the_default_high_pass_says_which_corner_to_move(analytic):
+    """A record sampled at 1 Hz has its default low-pass corner at 0.4 Hz, below the
+    default high-pass corner 0.5 Hz of the record tools: one line naming both and the fix."""
+    rec = Record(data=analytic.a[::200], dt=1.0, quantity="acceleration")
+    with pytest.raises(RecordError, match=r"freqmin=0.5 Hz is not below .* freqmax=0.4 Hz .* 1 Hz\); "
+                                          r"lower freqmin \(--freqmin\), e.g. to 0.04 Hz") as refused:
+        process_record(rec, ProcessingSettings(freqmin=0.5))
+    assert "\n" not in str(refused.value)
+
+
 def test_freqmax_above_nyquist_is_refused(analytic):
     rec = Record(data=analytic.a, dt=analytic.dt, quantity="acceleration")
     with pytest.raises(RecordError, match="Nyquist"):
