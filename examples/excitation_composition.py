@@ -8,9 +8,9 @@ table, the Excitation FMU connected to the block in an SSP file run by fmpy, and
 same file run by libcosim (harness/ground/compose.py).  For each communication step the
 script prints the errors against the reference sampled at the same step and saves
 out/communication_step.md and out/communication_step.png.  The default set takes about
-two minutes of CPU (measured: 101 s user + 9 s system); its wall time depends on the
-machine's load: 4 min 22 s, and 8 min 40 s while tests ran beside it, on the shared 2-core
-development machine.  Most of it is fmpy's 240,000 communication steps at h = 0.05.
+two minutes of CPU (measured from a fresh clone: 102 s user + 15 s system, 1 min 58 s of
+wall time on an idle 2-core machine; 4-9 min of wall time where other work shared it).
+Most of it is fmpy's 240,000 communication steps at h = 0.05.
 """
 from __future__ import annotations
 
