@@ -37,8 +37,10 @@ run: fmus
 	$(PY) -m harness.main
 
 # pytest exits non-zero when no test ran (exit code 5), so an empty run fails here too.
+# One worker per core (pytest-xdist), a test file's tests on one worker: most of a fresh
+# run's time is numba compiling the kernels a file needs, once per worker.
 test: fmus
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist loadfile
 
 benchmark: fmus
 	$(PY) -m harness.benchmarks.core_and_fmu
