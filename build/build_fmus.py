@@ -1,7 +1,8 @@
 """Build the vibroblock FMUs: ``python build/build_fmus.py [--dest build/fmus] [NAME ...]``.
 
 One FMU per registered model variant (``vibroblock.models``: ``Block<Name>.fmu``, its
-facade script generated here) and one per FMU script in ``fmu_src`` (``Excitation``),
+facade script generated here) and one per FMU script in ``fmu_src`` (``Excitation``,
+``BlockChain``: its number of blocks is fixed here, ``--chain-blocks N``),
 FMI 2.0 co-simulation, with the physics core ``fmu_src/vibroblock`` bundled as pythonfmu
 project files.  ``--list`` prints the names; ``--sources`` builds from another source
 tree (e.g. a copy with one more variant).  After pythonfmu has written the archive, finishing steps make it a
@@ -154,10 +155,22 @@ def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
     tmp_path.replace(fmu)
 
 
-def build(name: str, dest: Path, ship_kernels: bool = True) -> Path:
+def chain_script(n_blocks: int) -> str:
+    """The BlockChain FMU script with its number of blocks set to ``n_blocks``."""
+    if n_blocks < 1:
+        raise SystemExit(f"--chain-blocks {n_blocks}: a chain has at least one block")
+    text = (SOURCES / "BlockChain.py").read_text()
+    default = "\nN_BLOCKS = "
+    start = text.index(default) + len(default)
+    return text[:start] + str(int(n_blocks)) + text[text.index("\n", start):]
+
+
+def build(name: str, dest: Path, ship_kernels: bool = True, chain_blocks: int | None = None) -> Path:
     from pythonfmu.builder import FmuBuilder
 
     generated = variant_scripts()
+    if chain_blocks is not None:
+        generated["BlockChain"] = chain_script(chain_blocks)
     with tempfile.TemporaryDirectory() as scratch:
         script = SOURCES / f"{name}.py"
         if name in generated:
@@ -177,7 +190,7 @@ def build(name: str, dest: Path, ship_kernels: bool = True) -> Path:
     wrap_fmu(fmu)
     import documentation
     extra = {PYTHON_ENVIRONMENT: python_environment_record(), **documentation.archive_members(name)}
-    if name.startswith("Block") and ship_kernels:
+    if name.startswith("Block") and ship_kernels:  # the variants' and BlockChain ("Chain")
         import kernels
         extra.update(kernels.archive_members(CORE, name[len("Block"):]))
     finish_archive(fmu, extra)
@@ -190,6 +203,8 @@ def main(argv=None) -> int:
     parser.add_argument("--dest", type=Path, default=DEFAULT_DEST, help="output folder")
     parser.add_argument("--sources", type=Path, default=SOURCES, help="source tree (fmu_src)")
     parser.add_argument("--list", action="store_true", help="print the FMU names and stop")
+    parser.add_argument("--chain-blocks", type=int, default=None,
+                        help="the number of blocks of BlockChain.fmu (default: N_BLOCKS of fmu_src/BlockChain.py)")
     parser.add_argument("--without-kernels", action="store_true",
                         help="do not ship compiled kernels (the first doStep compiles them)")
     args = parser.parse_args(argv)
@@ -199,7 +214,7 @@ def main(argv=None) -> int:
         return 0
     args.dest.mkdir(parents=True, exist_ok=True)
     for name in args.names or fmu_names():
-        print(f"built {build(name, args.dest, ship_kernels=not args.without_kernels)}")
+        print(f"built {build(name, args.dest, ship_kernels=not args.without_kernels, chain_blocks=args.chain_blocks)}")
     return 0
 
 

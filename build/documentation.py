@@ -181,6 +181,34 @@ SEED file, for a record in counts); empty for the bundled record.</p>
 """
 
 
+def chain_html(identifier: str) -> str:
+    from vibroblock.chain.runner import BLOCK_DEFAULTS, CHAIN_PARAMETERS, chain_defaults
+    from vibroblock.chain.slave import AGGREGATES, BLOCK_PARAMETERS, CATALOG_TEXT
+    from vibroblock.models import defaults, parameters_for
+
+    specs, values = {p.name: p for p in parameters_for("A")}, {**defaults("A"), **BLOCK_DEFAULTS}
+    rows = [(f"<code>{'k_p' if n == 'k_d' else n}</code>", _e(specs[n].unit), f"{values[n]:g}",
+             _e(specs[n].description)) for n in BLOCK_PARAMETERS]
+    rows += [(f"<code>{n}</code>", _e(unit), f"{chain_defaults()[n]:g}", _e(text))
+             for n, (_, unit, text) in CHAIN_PARAMETERS.items()]
+    outputs = [(f"<code>{n}</code>", _e(unit), _e(text)) for n, (_, unit, text) in AGGREGATES.items()]
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{identifier}</title><style>{STYLE}</style></head>
+<body><h1>{identifier}: a chain of blocks on a vibrating plate</h1>
+<p>N blocks in a row (Burridge-Knopoff), each a model-A block with the single block's contact and
+friction laws and its symplectic Euler step; a leaf spring <code>k_p</code> pulls each towards the
+loader at <code>V_d t</code>, springs <code>k_c</code> couple neighbours (free or periodic ends).
+Per-block outputs <code>x[i]</code>, <code>vx[i]</code>, i = 1..N, N fixed when the FMU was built.</p>
+<h2>Parameters</h2>
+{_table(("name", "unit", "default", "meaning"), rows)}
+<p><code>catalog_file</code> (String): {_e(CATALOG_TEXT)}.</p>
+<h2>Outputs</h2>
+{_table(("name", "unit", "meaning"), outputs)}
+{PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
+</body></html>
+"""
+
+
 def icon_png(model: str | None) -> bytes:
     """A 128 x 128 icon: the block on its plate with the drive spring, or a chirp."""
     import matplotlib
@@ -217,7 +245,10 @@ def icon_png(model: str | None) -> bytes:
 
 def archive_members(name: str) -> dict[str, bytes]:
     """``documentation/index.html`` and ``model.png`` for the FMU ``name``."""
-    if name.startswith("Block"):
+    if name == "BlockChain":
+        model = "A"
+        page = chain_html(name)
+    elif name.startswith("Block"):
         model = name[len("Block"):]
         page = block_html(model, name)
     else:

@@ -48,6 +48,8 @@ MAX_CHILDREN = 8
 # them at a first use would take longer than a first use may (issue 33: 30 s).  adaptive's
 # took 69 s of CPU on the 2-core machine, the others 6-20 s (build_cost, section 1).
 SHIPPED_ALWAYS = ("adaptive",)
+# The job of the chain's kernel (vibroblock/chain/kernel.py), which the BlockChain FMU ships.
+CHAIN_JOB = "chain"
 # Relative compile costs measured on one core (harness/benchmarks/build_cost.py), so the
 # most expensive jobs start first and the children finish together.
 COST = {"adaptive": 10, "event_driven": 4, "implicit_contact": 3}
@@ -58,6 +60,7 @@ COST = {"adaptive": 10, "event_driven": 4, "implicit_contact": 3}
 # in the first configuration the core accepts for it.  Prints the configuration as JSON.
 WARM_UP = r"""
 import itertools, json, sys
+CHAIN_JOB = "chain"
 from vibroblock import Block, INTEGRATORS, ModelError
 from vibroblock.integrators import BY_ID
 from vibroblock.models import VARIANTS
@@ -65,6 +68,15 @@ from vibroblock.native import NativeStep
 from vibroblock.parameters import INTEGRATOR_OPTIONS, SCENE_OPTIONS
 
 job = sys.argv[1]
+if job == CHAIN_JOB:  # the chain's kernel, with and without the energy balance
+    from vibroblock.chain import Chain
+    for energy_balance in (False, True):
+        chain = Chain(2, energy_balance=energy_balance, A=0.3, omega=0.5)
+        chain.start(0.0)
+        chain.advance_to(1.0)
+        chain.outputs()
+    print(json.dumps({"job": job}))
+    sys.exit(0)
 options = [{}] + [{name: True} for name in SCENE_OPTIONS] + [
     {name: not default} for name, (_, default, _) in INTEGRATOR_OPTIONS.items()]
 for model, integrator, option in itertools.product(VARIANTS, INTEGRATORS, options):
@@ -109,7 +121,8 @@ def kernel_jobs() -> list[str]:
     """One job per compiled kernel pair: the names of the integrator records by id
     (``adaptive`` handing model A over runs ``event_driven``'s, the same id)."""
     from vibroblock.integrators import BY_ID
-    return sorted({record.name for record in BY_ID.values()}, key=lambda name: (-COST.get(name, 1), name))
+    names = {record.name for record in BY_ID.values()} | {CHAIN_JOB}
+    return sorted(names, key=lambda name: (-COST.get(name, 1), name))
 
 
 def shipped_jobs(model: str) -> list[str]:
@@ -135,6 +148,8 @@ def entry_files(job_cache: Path) -> list[Path]:
     cached on their own as well, but loading an entry point does not read them."""
     from vibroblock.integrators import BY_ID
 
+    if job_cache.name == CHAIN_JOB:
+        return [path for path in sorted(job_cache.rglob("*.nb?")) if path.name.startswith("kernel.advance-")]
     record = next(record for record in BY_ID.values() if record.name == job_cache.name)
     # numba names a cache file "<source file's stem>.<qualname>-<line>..." ("__init__" for
     # a kernel defined in a package's __init__.py, e.g. event_driven's).
@@ -191,10 +206,11 @@ def job_caches(core: Path) -> list[Path]:
 
 def archive_members(core: Path, model: str) -> dict[str, bytes]:
     """The FMU members ``resources/vibroblock_kernels/...`` of the Block FMU of ``model``:
-    the kernels of ``shipped_jobs`` for the core at ``core``."""
+    the kernels of ``shipped_jobs`` for the core at ``core``; ``model`` "Chain": the
+    BlockChain FMU's, the chain's kernel."""
     folder = compile_kernels(core)
     members = {}
-    for job in shipped_jobs(model):
+    for job in [CHAIN_JOB] if model == "Chain" else shipped_jobs(model):
         for path in entry_files(folder / job):
             members[f"{ARCHIVE_FOLDER}/{path.relative_to(folder / job).as_posix()}"] = path.read_bytes()
     return members

@@ -26,3 +26,21 @@ def data_pointer(typingctx, array):
         return context.make_array(array)(context, builder, value=args[0]).data
 
     return types.CPointer(array.dtype)(array), codegen
+
+
+@intrinsic
+def row_pointer(typingctx, array, row):
+    """Row ``row`` of a 2-D C-contiguous ``array`` as a ``CPointer`` (``p[j]`` is
+    ``array[row, j]``): one block's slots of a chain's per-block arrays, handed to the
+    single block's functions as if they were that block's own 1-D arrays."""
+    if not (isinstance(array, types.Array) and array.ndim == 2 and array.layout == "C"
+            and isinstance(row, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(array)(context, builder, value=args[0])
+        columns = builder.extract_value(data.shape, 1)
+        index = context.cast(builder, args[1], row, types.intp)
+        return builder.gep(data.data, [builder.mul(index, columns)])
+
+    return types.CPointer(array.dtype)(array, row), codegen

@@ -37,10 +37,12 @@ def test_each_fmu_documents_itself(fmu_dir):
             icon = fmu.read("model.png")
         assert icon.startswith(b"\x89PNG") and icon[16:24] == (128).to_bytes(4, "big") * 2
         assert "VIBROBLOCK_PYTHON" in page and "vibroblock-python.txt" in page
-        if name.startswith("Block"):
+        if name in build_fmus.variant_scripts():
             model = name[-1]
             for spec in parameters_for(model):
                 assert f"<td><code>{spec.name}</code></td><td>{spec.unit}</td><td>{defaults(model)[spec.name]:g}</td>" \
                     in page, spec.name
             assert all(f"<code>{integrator}</code>" in page for integrator in INTEGRATORS)
             assert "Equations" in page and "mu_s N" in page
+        if name == "BlockChain":
+            assert all(f"<code>{n}</code>" in page for n in ("k_p", "k_c", "v_start", "v_stop", "event_count"))

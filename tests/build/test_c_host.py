@@ -28,7 +28,7 @@ fmi2DeSerializeFMUstate fmi2GetDirectionalDerivative fmi2SetRealInputDerivatives
 fmi2DoStep fmi2CancelStep fmi2GetStatus fmi2GetRealStatus fmi2GetIntegerStatus fmi2GetBooleanStatus
 fmi2GetStringStatus""".split()
 KIND = {"Real": "r", "Integer": "i", "Boolean": "b"}
-NAMES = ("BlockA", "BlockB", "BlockC", "Excitation")
+NAMES = ("BlockA", "BlockB", "BlockC", "Excitation", "BlockChain")
 
 
 def clean_env(**extra) -> dict:
@@ -202,6 +202,17 @@ def test_do_steps_through_pythonfmu_give_the_same_bits(host, fmus, name):
     assert_same_bits(runs[0], runs[1])
 
 
+def test_the_chain_gives_fmpys_bits(host, fmus):
+    """A chain driven through its plate inputs, heterogeneous, coupled: every output."""
+    folder, md = fmus["BlockChain"]
+    settings = {"mu_s_spread": 0.3, "seed": 2}
+    ours = host_run(host, fmus, "BlockChain", settings, 0.0, 6000.0, 2.0, drive=(0.05, 0.2))
+    reference = fmpy_driven(folder, md, settings, 0.0, 6000.0, 2.0, 0.05, 0.2)
+    assert_same_bits(ours, reference)
+    names = [v.name for v in columns(md)]
+    assert ours[-1, 1 + names.index("coulomb_resets")] > 0 and np.ptp(ours[:, 1 + names.index("x[1]")]) > 10.0
+
+
 @pytest.mark.parametrize("settings", [{}, {"mode": 1, "omega_start": 0.2, "omega_end": 2.0, "sweep_time": 50.0}])
 def test_excitation_gives_fmpys_bits(host, fmus, settings):
     folder, md = fmus["Excitation"]
@@ -216,7 +227,8 @@ def test_excitation_gives_fmpys_bits(host, fmus, settings):
 
 # ---------------------------------------------------------------- what FMI 2.0 requires
 @pytest.mark.parametrize("name, output, parameter", [
-    ("BlockA", "z", "k_t"), ("BlockB", "x", "A_x"), ("BlockC", "z", "P_l"), ("Excitation", "plate_z", "omega")])
+    ("BlockA", "z", "k_t"), ("BlockB", "x", "A_x"), ("BlockC", "z", "P_l"), ("Excitation", "plate_z", "omega"),
+    ("BlockChain", "x[1]", "k_c")])
 def test_the_calls_fmi_requires(host, fmus, name, output, parameter):
     folder, md = fmus[name]
     by_name = {v.name: v for v in md.modelVariables}

@@ -20,11 +20,13 @@ def prepare(kind, flags, drv, prm, h):
 
 
 @njit(inline="always")
-def euler_step(kind, prm, state, t, h, contact_now, plate, track_energy):
+def euler_step(kind, prm, state, t, h, contact_now, plate, track_energy, push):
     """One semi-implicit Euler step of length h from ``state`` = (x, z, vx, vz, F), whose
     contact quantities ``contact_now`` are known, ``plate`` = (its velocity at t, height
     and velocity at t + h); returns the new state, its contact quantities, and the
-    increments of phi, work, dissipation and normal-spring energy."""
+    increments of phi, work, dissipation and normal-spring energy.  ``push`` is an
+    extra horizontal force from outside the block (a chain's coupling springs, whose
+    energy the chain books itself)."""
     x, z, vx, vz, shear = state
     plate_v, pz1, pv1 = plate
     h_over_m = h / prm[P_M]
@@ -35,6 +37,8 @@ def euler_step(kind, prm, state, t, h, contact_now, plate, track_energy):
         work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, pen > 0.0, contact_now, plate_v, prm)
         d_work, d_dissipated, d_normal = h * work, h * dissipation, h * storage
     engaged = pen > 0.0
+    if push != 0.0:  # (a lone block adds nothing, not even the sign of a zero)
+        fx += push
     vx += h_over_m * fx
     vz += h_over_m * fz
     rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz) for a point
@@ -52,5 +56,5 @@ def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy
     pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
     t, h, span = clock
     x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
-        kind, prm, state, t, h, contact0, (pv0, pz1, pv1), track_energy)
+        kind, prm, state, t, h, contact0, (pv0, pz1, pv1), track_energy, 0.0)
     return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)

@@ -4,7 +4,7 @@ import pytest
 from numba import njit
 from numba.core.errors import TypingError
 
-from vibroblock.unowned import data_pointer
+from vibroblock.unowned import data_pointer, row_pointer
 
 
 @njit
@@ -34,3 +34,22 @@ def test_a_strided_array_is_refused_at_compile_time():
     """A pointer to a view's data would read the base array's elements, not the view's."""
     with pytest.raises(TypingError):
         _first(np.arange(6.0)[::2])
+
+
+@njit
+def _bump_row(table, row):
+    """Doubles every slot of one row through its row pointer."""
+    p = row_pointer(table, row)
+    for j in range(table.shape[1]):
+        p[j] *= 2.0
+
+
+def test_a_row_pointer_reaches_that_row_and_no_other():
+    table = np.arange(12.0).reshape(3, 4)
+    _bump_row(table, 1)
+    assert table.tolist() == [[0.0, 1.0, 2.0, 3.0], [8.0, 10.0, 12.0, 14.0], [8.0, 9.0, 10.0, 11.0]]
+
+
+def test_a_row_pointer_of_a_transposed_table_is_refused():
+    with pytest.raises(TypingError):
+        _bump_row(np.arange(12.0).reshape(3, 4).T, 0)

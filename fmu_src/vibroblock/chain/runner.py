@@ -1,0 +1,273 @@
+"""A chain of blocks on the vibrating plate (Burridge-Knopoff): the runner the
+BlockChain FMU and the harness drive, as ``Block`` is for one block.
+
+Every block is a model-A block with the single block's laws and scheme
+(``chain.kernel``); the chain adds the coupling springs k_c between neighbours, a leaf
+spring k_p (the single block's drive spring k_d) per block, per-block mu_s drawn from a
+seeded distribution, and the event catalogue.  Outputs are at the grid point at or
+before the requested time (a communication step that is a multiple of dt hits the grid).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import layout as L
+from .. import run_arrays
+from ..initial_state import place
+from ..observation import contact_energy
+from ..laws import law
+from ..settings import ModelError, Settings
+from . import kernel as K
+from .catalog import CatalogFile, magnitude
+
+GRID_TOLERANCE = 1e-6
+CATALOG_ROWS = 4096  # rows the kernel fills before the runner empties them
+# The chain's own parameters: name -> (default, unit, description).  The blocks'
+# parameters are model A's, with the drive spring k_d called k_p (the leaf spring).
+CHAIN_PARAMETERS = {
+    "k_c": (1.0, "m/tau_0^2", "coupling spring between neighbouring blocks (l^2 = k_c/k_p = 100 by default)"),
+    "v_start": (0.3, "delta_0/tau_0", "slip speed |vx| above which a block slips: opens an event"),
+    "v_stop": (0.1, "delta_0/tau_0", "an event closes once every block's slip speed is below this (above the "
+                                      "ringing of a block that has stuck again)"),
+    "mu_s_spread": (0.0, "1", "heterogeneity: each block's mu_s is mu_s (1 + mu_s_spread u), u uniform in [-1, 1]"),
+    "seed": (0.0, "1", "seed of the heterogeneity's random draw (an integer)"),
+}
+
+
+# The blocks' defaults where they differ from model A's: the loading of the single block's
+# stick-slip benchmarks (a loading cycle of ~5e3 tau_0 instead of the paper's ~5e7) and a
+# step the contact resolves (30 steps per contact period), so that catalogues of
+# thousands of events take minutes.
+BLOCK_DEFAULTS = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3, "dt": 1e-2}
+
+
+def chain_defaults() -> dict:
+    return {name: value for name, (value, _, _) in CHAIN_PARAMETERS.items()}
+
+
+class Chain:
+    """N blocks in a row on the vibrating plate.  Typical use::
+
+        chain = Chain(16, A=0.5, omega=0.8)
+        chain.start()
+        chain.advance_to(1e4)
+        chain.outputs()["event_count"], chain.x
+    """
+
+    def __init__(self, n_blocks: int = 16, *, periodic: bool = False, energy_balance: bool = False,
+                 catalog_path: str | Path | None = None, **parameters):
+        if not (isinstance(n_blocks, (int, np.integer)) and n_blocks >= 1):
+            raise ModelError(f"n_blocks = {n_blocks!r}: a chain has at least one block")
+        self.n_blocks, self.periodic, self.energy_balance = int(n_blocks), bool(periodic), bool(energy_balance)
+        self.chain_parameters = chain_defaults()
+        block = dict(BLOCK_DEFAULTS)
+        for name, value in parameters.items():
+            if name in self.chain_parameters:
+                self.chain_parameters[name] = float(value)
+            else:
+                block["k_d" if name == "k_p" else name] = value
+        self.settings = Settings("A", "symplectic_euler", 0, self.energy_balance, **block)
+        self.catalog_file = CatalogFile(catalog_path) if catalog_path else None
+        self.started = False
+
+    # ------------------------------------------------------------------ settings
+    def set_parameter(self, name: str, value: float) -> None:
+        if self.started:
+            raise ModelError(f"{name} cannot change during a run")
+        if name in self.chain_parameters:
+            if not math.isfinite(value):
+                raise ModelError(f"{name} = {value!r} is not finite")
+            self.chain_parameters[name] = float(value)
+        else:
+            self.settings.set_parameter("k_d" if name == "k_p" else name, value)
+
+    def parameter(self, name: str) -> float:
+        if name in self.chain_parameters:
+            return self.chain_parameters[name]
+        return self.settings.parameters["k_d" if name == "k_p" else name]
+
+    def _check(self) -> None:
+        p = self.chain_parameters
+        if not p["k_c"] >= 0.0:
+            raise ModelError(f"k_c = {p['k_c']!r} must be >= 0")
+        if not 0.0 < p["v_stop"] <= p["v_start"]:
+            raise ModelError(f"the event thresholds must be 0 < v_stop <= v_start (v_stop = {p['v_stop']!r}, "
+                             f"v_start = {p['v_start']!r})")
+        if not 0.0 <= p["mu_s_spread"] < 1.0:
+            raise ModelError(f"mu_s_spread = {p['mu_s_spread']!r} must be in [0, 1): every mu_s stays positive")
+        if p["seed"] != int(p["seed"]) or p["seed"] < 0:
+            raise ModelError(f"seed = {p['seed']!r} must be a non-negative integer")
+        # The coupling is one more spring on each block: the scheme's stability bound
+        # (which Settings checks for k_n, k_t, k_d) with the stiffest coupling mode, 4 k_c.
+        m, dt = self.settings.parameters["m"], self.settings.parameters["dt"]
+        stiffest = self.settings.parameters["k_t"] + self.settings.parameters["k_d"] + 4.0 * p["k_c"]
+        if dt * dt * stiffest / m > 1.0:
+            raise ModelError(f"dt = {dt!r} is too large for the coupling: dt^2 (k_t + k_p + 4 k_c)/m = "
+                             f"{dt * dt * stiffest / m:.3g} > 1; take dt <= {math.sqrt(m / stiffest):.3g}")
+
+    # ------------------------------------------------------------------ running
+    def start(self, t0: float = 0.0) -> None:
+        if not math.isfinite(t0):
+            raise ModelError(f"start time {t0!r} is not finite")
+        self.settings.check()
+        self._check()
+        y, self.cnt, self.drv, prm = run_arrays.fresh(self.settings.parameters, t0)
+        place(self.settings, prm, self.drv, y)
+        p = self.chain_parameters
+        self.Y = np.ascontiguousarray(np.tile(y, (self.n_blocks, 1)))
+        self.PRM = np.ascontiguousarray(np.tile(prm, (self.n_blocks, 1)))
+        if p["mu_s_spread"] > 0.0:
+            draw = np.random.default_rng(int(p["seed"])).uniform(-1.0, 1.0, self.n_blocks)
+            self.PRM[:, L.P_MUS] *= 1.0 + p["mu_s_spread"] * draw
+        self.chn = np.array([p["k_c"], float(self.periodic), p["v_start"], p["v_stop"]])
+        self.evt = np.zeros(K.N_EVT)
+        self.scratch = np.zeros((self.n_blocks, K.N_SCRATCH))
+        self.rows = np.zeros((CATALOG_ROWS, K.N_ROW))
+        self.events: list[tuple] = []
+        self.time = float(t0)
+        plate_z = self.settings.parameters["A"] * math.sin(self.drv[L.D_PHASE])
+        for i in range(self.n_blocks):
+            self.Y[i, L.Y_E_NORMAL] = contact_energy(self.settings, self.PRM[i], plate_z - self.Y[i, L.Y_Z])
+        self.energy_at_start = self.stored_energy(plate_z)
+        self.started = True
+        if self.catalog_file is not None:
+            self.catalog_file.begin(self.describe_thresholds())
+
+    def set_velocities(self, vx) -> None:
+        """Give the blocks these slip velocities at the start (a kick, e.g. along a normal
+        mode); the stored energy at the start counts them."""
+        self._require_started()
+        vx = np.asarray(vx, dtype=float)
+        if self.cnt[L.C_STEP] != 0 or vx.shape != (self.n_blocks,) or not np.all(np.isfinite(vx)):
+            raise ModelError(f"set_velocities takes {self.n_blocks} finite velocities, before the first step")
+        self.Y[:, L.Y_VX] = vx
+        self.energy_at_start = self.stored_energy()
+
+    def set_plate_input(self, z: float, v: float, a: float) -> None:
+        run_arrays.check_plate_input(z, v, a)
+        self._require_started()
+        run_arrays.set_plate_input(self.drv, self.time, z, v, a)
+
+    def advance_to(self, t_end: float) -> None:
+        """Advance to the grid point at or before t_end; on failure the state is kept."""
+        self._require_started()
+        if not self.time < t_end < math.inf:
+            raise ModelError(f"cannot advance from t = {self.time!r} to t = {t_end!r}: "
+                             "the end time must be finite and later than the current time")
+        t0, dt = self.drv[L.D_T0], self.drv[L.D_DT]
+        target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
+        kept = (self.Y.copy(), self.cnt.copy(), self.evt.copy(), self.scratch.copy())
+        while self.cnt[L.C_STEP] < target:
+            status = K.advance(self.settings.kind, self.Y, self.PRM, self.cnt, self.drv, self.chn, self.evt,
+                               self.scratch, self.rows, int(target - self.cnt[L.C_STEP]), self.energy_balance)
+            if status == K.NON_FINITE:
+                self.Y, self.cnt, self.evt, self.scratch = kept
+                raise ModelError(f"the chain's state became non-finite between t = {self.time!r} and {t_end!r} "
+                                 f"(dt = {dt!r}): a smaller dt, or softer springs; the state at t = {self.time!r} "
+                                 "is kept")
+            self._take_events()
+        self.time = float(t_end)
+
+    def _take_events(self) -> None:
+        """Move the events the kernel closed into the catalogue (and its file)."""
+        rows = int(self.evt[K.E_ROWS])
+        if rows:
+            closed = [tuple(float(v) for v in row) for row in self.rows[:rows]]
+            self.events.extend(closed)
+            if self.catalog_file is not None:
+                self.catalog_file.append(closed)
+            self.evt[K.E_ROWS] = 0.0
+
+    def _require_started(self) -> None:
+        if not self.started:
+            raise ModelError("the run has not started: call start() (FMI: exit initialization mode) first")
+
+    # ------------------------------------------------------------------ observing
+    x = property(lambda self: self.Y[:, L.Y_X].copy(), doc="Each block's displacement.")
+    vx = property(lambda self: self.Y[:, L.Y_VX].copy(), doc="Each block's slip velocity.")
+    mu_s = property(lambda self: self.PRM[:, L.P_MUS].copy(), doc="Each block's static friction coefficient.")
+    grid_time = property(lambda self: float(self.drv[L.D_T0] + self.cnt[L.C_STEP] * self.drv[L.D_DT]))
+
+    def plate_height(self) -> float:
+        """The plate height at the stored grid state (what the kernel's last step used)."""
+        from ..integrators.plate import plate_after
+        return float(plate_after(self.drv, self.cnt, int(self.cnt[L.C_STEP]), 0.0)[0])
+
+    def stored_energy(self, plate_z: float | None = None) -> float:
+        """Kinetic, leaf-spring, friction-spring and contact energy of every block, and the
+        coupling springs' energy, at the stored grid state."""
+        plate_z = self.plate_height() if plate_z is None else plate_z
+        p = self.settings.parameters
+        Y, t = self.Y, self.grid_time
+        friction = law("friction", self.settings.readings.get("friction_law", 0)).module.energy.py_func
+        total = 0.0
+        for i in range(self.n_blocks):
+            x, vx, vz, shear = Y[i, L.Y_X], Y[i, L.Y_VX], Y[i, L.Y_VZ], Y[i, L.Y_F]
+            stretch = x - p["V_d"] * t
+            total += (0.5 * p["m"] * (vx * vx + vz * vz) + 0.5 * p["k_d"] * stretch * stretch
+                      + float(friction(shear, self.PRM[i])) + contact_energy(self.settings, self.PRM[i],
+                                                                             plate_z - Y[i, L.Y_Z]))
+        bonds = np.diff(Y[:, L.Y_X])
+        if self.periodic and self.n_blocks > 2:
+            bonds = np.append(bonds, Y[0, L.Y_X] - Y[-1, L.Y_X])
+        return total + 0.5 * self.chain_parameters["k_c"] * float(np.sum(bonds * bonds))
+
+    def outputs(self) -> dict:
+        """The aggregates a master plots."""
+        self._require_started()
+        vx = self.Y[:, L.Y_VX]
+        residual = 0.0
+        if self.energy_balance:
+            residual = (self.stored_energy() - self.energy_at_start - float(np.sum(self.Y[:, L.Y_WORK]))
+                        + float(np.sum(self.Y[:, L.Y_DISSIPATED])))
+        last = float(self.evt[K.E_LAST])
+        return {
+            "mean_slip_velocity": float(np.mean(vx)),
+            "moment_rate": float(np.sum(vx)),
+            "slipping_fraction": float(np.mean(np.abs(vx) > self.chain_parameters["v_start"])),
+            "event_count": int(self.evt[K.E_CLOSED]),
+            "last_event_potency": last,
+            "last_event_magnitude": magnitude(last),
+            "coulomb_resets": int(np.sum(self.scratch[:, K.S_RESETS])),
+            "work_input": float(np.sum(self.Y[:, L.Y_WORK])),
+            "energy_dissipated": float(np.sum(self.Y[:, L.Y_DISSIPATED])),
+            "energy_residual": float(residual),
+        }
+
+    def describe_thresholds(self) -> str:
+        p = self.chain_parameters
+        return (f"event start: a block's |vx| > v_start = {p['v_start']:g}; end: every |vx| < v_stop = "
+                f"{p['v_stop']:g} (delta_0/tau_0); N = {self.n_blocks}, k_c = {p['k_c']:g}, "
+                f"k_p = {self.settings.parameters['k_d']:g}, dt = {self.settings.parameters['dt']:g}")
+
+    # ------------------------------------------------------------------ state
+    def get_state(self) -> dict:
+        """Everything needed to continue the run bit for bit, as plain values (the catalogue
+        file is not part of it: it records events as they close)."""
+        self._require_started()
+        return {"n_blocks": self.n_blocks, "periodic": self.periodic, "energy_balance": self.energy_balance,
+                "time": self.time, "energy_at_start": self.energy_at_start, "events": list(self.events),
+                "chain_parameters": dict(self.chain_parameters), "settings": self.settings.to_dict(),
+                **{name: getattr(self, name).tolist() for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch")}}
+
+    def set_state(self, state: dict) -> None:
+        try:
+            arrays = {name: np.ascontiguousarray(state[name], dtype=np.int64 if name == "cnt" else float)
+                      for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch")}
+            n_blocks = int(state["n_blocks"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"not a valid chain state: {exc}") from None
+        if n_blocks != self.n_blocks or arrays["Y"].shape != (n_blocks, L.N_Y):
+            raise ModelError(f"not a valid chain state: it holds {n_blocks} blocks, this chain {self.n_blocks}")
+        self.settings = Settings.from_dict(state["settings"], "A")
+        self.chain_parameters = dict(state["chain_parameters"])
+        self.periodic, self.energy_balance = bool(state["periodic"]), bool(state["energy_balance"])
+        for name, value in arrays.items():
+            setattr(self, name, value)
+        self.rows = np.zeros((CATALOG_ROWS, K.N_ROW))
+        self.events = [tuple(e) for e in state["events"]]
+        self.time, self.energy_at_start = float(state["time"]), float(state["energy_at_start"])
+        self.started = True

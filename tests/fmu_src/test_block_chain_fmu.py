@@ -1,0 +1,105 @@
+"""BlockChain.fmu as FMI 2.0 masters see it: validation, the core's bits, the catalogue
+file, FMU state, bad input, another N at build time, libcosim."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave, fmi2Error
+from fmpy.validation import validate_fmu
+
+from fmu_testing import do_step, fmu_log, status_of  # noqa: F401 (fixture)
+from harness.chain.catalog import read_catalog
+from harness.chain.run import simulate_chain
+from harness.cosim.masters import run_libcosim
+from vibroblock.chain import Chain
+
+SETTINGS = {"mu_s_spread": 0.3, "seed": 4, "A": 0.05, "omega": 1.3}
+
+
+@pytest.fixture(scope="module")
+def chain_fmu(fmu_dir):
+    return str(fmu_dir / "BlockChain.fmu")
+
+
+def test_fmpy_validation_reports_nothing_and_every_block_has_its_outputs(chain_fmu):
+    assert validate_fmu(chain_fmu) == []
+    names = {v.name for v in read_model_description(chain_fmu).modelVariables}
+    assert {f"x[{i}]" for i in range(1, 17)} <= names and "x[17]" not in names and "vx[16]" in names
+
+
+def test_outputs_and_catalogue_equal_the_cores(chain_fmu, tmp_path):
+    result, events = simulate_chain(chain_fmu, stop_time=15000.0, step_size=50.0, catalog=tmp_path / "events.csv",
+                                    start_values=SETTINGS, outputs=("event_count", "x[1]", "x[16]"))
+    chain = Chain(16, **SETTINGS)
+    chain.start()
+    for t in result["time"][1:]:
+        chain.advance_to(t)
+    assert result["x[16]"][-1] == chain.x[15] and result["x[1]"][-1] == chain.x[0]
+    assert result["event_count"][-1] == len(chain.events) == len(events) > 3
+    assert events["t_start"].tolist() == [e[0] for e in chain.events]
+    assert events["first_block"].tolist() == [int(e[2]) + 1 for e in chain.events]  # 1-based, as x[i]
+    assert "v_start = 0.3" in events.attrs["thresholds"] and "v_stop = 0.1" in events.attrs["thresholds"]
+
+
+@pytest.fixture
+def instance(chain_fmu, tmp_path, fmu_log):
+    md = read_model_description(chain_fmu)
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(chain_fmu, unzipdir=str(tmp_path / "x")),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="chain")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    yield slave, {v.name: v.valueReference for v in md.modelVariables}
+    slave.freeInstance()
+
+
+def test_fmu_state_restores_the_run_bit_for_bit(instance):
+    slave, vr = instance
+    slave.setReal([vr["mu_s_spread"]], [0.3])
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    slave.doStep(0.0, 2000.0)
+    state = slave.serializeFMUstate(slave.getFMUstate())
+    outputs = [vr[f"x[{i}]"] for i in range(1, 17)] + [vr["energy_residual"]]
+    slave.doStep(2000.0, 3000.0)
+    first = slave.getReal(outputs), slave.getInteger([vr["event_count"]])
+    slave.setFMUstate(slave.deSerializeFMUstate(state))
+    slave.doStep(2000.0, 3000.0)
+    assert (slave.getReal(outputs), slave.getInteger([vr["event_count"]])) == first
+    assert first[1][0] > 0
+
+
+def test_bad_settings_and_inputs_give_fmi2error_with_a_message(instance, fmu_log):
+    slave, vr = instance
+    slave.setReal([vr["v_stop"]], [1.0])  # above v_start = 0.3
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    assert status_of(slave.exitInitializationMode) == fmi2Error
+    assert any("0 < v_stop <= v_start" in record[3] for record in fmu_log.records)
+    slave.setReal([vr["v_stop"]], [0.1])
+    slave.exitInitializationMode()
+    assert status_of(lambda: slave.setReal([vr["plate_z"]], [float("nan")])) == fmi2Error
+    assert status_of(lambda: slave.setReal([vr["k_c"]], [2.0])) == fmi2Error  # fixed once running
+    assert do_step(slave, 0.0, 100.0) == 0  # the instance goes on
+
+
+def test_another_number_of_blocks_at_build_time(tmp_path):
+    import build_fmus
+
+    fmu = build_fmus.build("BlockChain", tmp_path, chain_blocks=3)
+    result = simulate_fmu(str(fmu), stop_time=500.0, output_interval=50.0, start_values={"k_c": 0.0},
+                          output=["x[1]", "x[3]"])
+    names = {v.name for v in read_model_description(str(fmu)).modelVariables}
+    assert "x[3]" in names and "x[4]" not in names
+    single = Chain(1, k_c=0.0)  # uncoupled, uniform blocks: each is the one-block chain
+    single.start()
+    single.advance_to(500.0)
+    assert result["x[3]"][-1] == result["x[1]"][-1] == single.x[0]
+
+
+def test_libcosim_gives_fmpys_bits(chain_fmu, tmp_path):
+    outputs = ["x[1]", "x[8]", "moment_rate", "event_count"]
+    cosim = run_libcosim(chain_fmu, start_values=SETTINGS, stop_time=3000.0, step_size=50.0, outputs=outputs)
+    fmpy = simulate_fmu(chain_fmu, stop_time=3000.0, output_interval=50.0, start_values=SETTINGS, output=outputs)
+    for name in outputs:
+        np.testing.assert_array_equal(np.asarray(cosim[name], dtype=float), fmpy[name].astype(float))

@@ -1,0 +1,138 @@
+"""The chain's step (``vibroblock.chain.kernel``): the single block's physics per block,
+the coupling springs' normal modes, the energy balance, and the event catalogue."""
+import math
+
+import numpy as np
+import pytest
+
+from vibroblock import Block
+from vibroblock import layout as L
+from vibroblock.chain import Chain
+from vibroblock.chain import runner
+
+# Stick-slip of the single block's benchmarks, on a vibrating plate (resets, detachments).
+VIBRATED = dict(A=0.3, omega=0.8, k_d=1e-2, V_d=1e-2, gamma_t=5e-3, dt=1e-2)
+
+
+def _chain(n, **parameters):
+    return Chain(n, **{("k_p" if k == "k_d" else k): v for k, v in parameters.items()})
+
+
+def test_a_chain_of_one_block_is_the_single_block_bit_for_bit():
+    """Same laws, same scheme, same arithmetic: every state slot and the energy residual."""
+    block = Block("A", "symplectic_euler", 0, True, **VIBRATED)
+    chain = _chain(1, energy_balance=True, **VIBRATED)
+    block.start()
+    chain.start()
+    for t in np.arange(1, 61) * 50.0:
+        block.advance_to(t)
+        chain.advance_to(t)
+    assert block.counters["resets"] > 10  # the run exercised the friction rule
+    assert chain.Y[0, :L.Y_E_START].tolist() == block.y[:L.Y_E_START].tolist()  # (the chain books E_start itself)
+    assert chain.outputs()["energy_residual"] == block.outputs()["energy_residual"]
+    assert chain.outputs()["coulomb_resets"] == block.counters["resets"]
+
+
+def test_uncoupled_blocks_are_independent_single_blocks_with_their_own_mu_s():
+    chain = _chain(3, k_c=0.0, mu_s_spread=0.4, seed=7, **VIBRATED)
+    chain.start()
+    chain.advance_to(1500.0)
+    assert len(set(chain.mu_s)) == 3
+    for i, mu_s in enumerate(chain.mu_s):
+        block = Block("A", "symplectic_euler", 0, False, **{**VIBRATED, "mu_s": float(mu_s)})
+        block.start()
+        block.advance_to(1500.0)
+        assert chain.Y[i, :5].tolist() == block.y[:5].tolist()
+
+
+def _laplacian(n, periodic):
+    lap = 2.0 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
+    if periodic:
+        lap[0, -1] = lap[-1, 0] = -1.0
+    else:
+        lap[0, 0] = lap[-1, -1] = 1.0
+    return lap
+
+
+def _frequency(samples, dt):
+    """Angular frequency of a sampled sinusoid from its first and last upward zero crossings."""
+    crossings = []
+    for k in range(len(samples) - 1):
+        if samples[k] < 0.0 <= samples[k + 1]:
+            crossings.append(k + samples[k] / (samples[k] - samples[k + 1]))
+    return 2.0 * math.pi * (len(crossings) - 1) / ((crossings[-1] - crossings[0]) * dt)
+
+
+@pytest.mark.parametrize("n, periodic", [(2, False), (3, False), (3, True)])
+def test_small_oscillations_of_stuck_blocks_ring_at_the_normal_mode_frequencies(n, periodic):
+    """Stuck blocks (the Cundall-Strack spring holds, no damping): horizontal stiffness
+    (k_p + k_t) I + k_c L, L the chain's Laplacian; each mode, kicked alone, rings at
+    omega_j = sqrt(eigenvalue / m), as symplectic Euler renders it:
+    (2/h) arcsin(omega_j h / 2)."""
+    k_p, k_t, k_c, dt = 1e-2, 0.28, 0.5, 1e-2
+    values, vectors = np.linalg.eigh((k_p + k_t) * np.eye(n) + k_c * _laplacian(n, periodic))
+    for j in range(n):
+        if j > 0 and abs(values[j] - values[j - 1]) < 1e-12:
+            continue  # a degenerate pair (periodic): the first of it is enough
+        chain = _chain(n, periodic=periodic, k_d=k_p, k_t=k_t, k_c=k_c, dt=dt, V_d=0.0, gamma_t=0.0,
+                       v_start=1.0, v_stop=0.5)
+        chain.start()
+        chain.set_velocities(1e-4 * vectors[:, j])
+        samples = []
+        for step in range(1, 40001):
+            chain.advance_to(step * 5 * dt)
+            samples.append(vectors[:, j] @ chain.x)
+        expected = 2.0 / dt * math.asin(math.sqrt(values[j]) * dt / 2.0)
+        assert _frequency(np.array(samples), 5 * dt) == pytest.approx(expected, rel=2e-5)
+        assert chain.outputs()["coulomb_resets"] == 0
+
+
+def test_the_energy_balance_closes_at_first_order_in_dt():
+    """Stored energy (blocks and coupling springs) - stored at start - work + dissipated:
+    symplectic Euler's first-order error, halved with dt; a coupling energy left out of
+    the books would not shrink."""
+    residuals = []
+    for dt in (1e-2, 5e-3):
+        chain = _chain(4, energy_balance=True, k_c=1.0, mu_s_spread=0.2, seed=3, **{**VIBRATED, "dt": dt})
+        chain.start()
+        chain.advance_to(3000.0)
+        outputs = chain.outputs()
+        assert outputs["event_count"] > 5
+        residuals.append(abs(outputs["energy_residual"]))
+        assert residuals[-1] < 2e-2 * outputs["work_input"]
+    assert 1.6 < residuals[0] / residuals[1] < 2.5
+
+
+def test_an_event_of_one_uncoupled_block_has_that_blocks_slip_as_potency():
+    """k_c = 0: an event of one block is that block's slip between the event's start and
+    end, which an independent single-block run gives."""
+    chain = _chain(2, k_c=0.0, mu_s_spread=0.3, seed=2, **VIBRATED)
+    chain.start()
+    chain.advance_to(4000.0)
+    single = [event for event in chain.events if event[3] == 1]
+    assert len(single) >= 3
+    for t_start, t_end, first, _, potency, peak in single[:3]:
+        block = Block("A", "symplectic_euler", 0, False, **{**VIBRATED, "mu_s": float(chain.mu_s[int(first)])})
+        block.start()
+        block.advance_to(t_start)
+        before = block.output("x")
+        block.advance_to(t_end)
+        assert potency == pytest.approx(block.output("x") - before, rel=1e-12, abs=1e-12)
+        assert peak > chain.chain_parameters["v_start"]
+
+
+def test_a_full_catalogue_loses_no_event_and_changes_nothing(monkeypatch):
+    """Without vibration the run does not depend on where the kernel stops: a catalogue of
+    two rows, emptied whenever full, gives the same events and the same state."""
+    parameters = dict(VIBRATED, A=0.0, omega=0.0)
+    big = _chain(8, mu_s_spread=0.3, seed=5, **parameters)
+    big.start()
+    big.advance_to(6000.0)
+    monkeypatch.setattr(runner, "CATALOG_ROWS", 2)
+    small = _chain(8, mu_s_spread=0.3, seed=5, **parameters)
+    small.start()
+    small.advance_to(6000.0)
+    assert len(big.events) > 4
+    assert small.events == big.events
+    assert small.Y.tolist() == big.Y.tolist()
+    assert small.outputs()["event_count"] == len(big.events)
