@@ -177,8 +177,9 @@ def coulomb_bound(kind, normal, x, t, prm):
 
 
 @njit(inline="always")
-def friction_rule(kind, shear, penetration, normal, prm):
+def friction_rule(kind, shear, sliding, penetration, normal, slip_rate, prm):
     """The friction law's rule at a new state (``laws``: friction; the paper's: F = 0 once
-    detached, or when |k_t F| >= mu_s N).  Returns the new shear displacement and whether
-    a reset of a loaded spring happened."""
-    return law_friction_rule(kind, shear, penetration, normal, prm)
+    detached, or when |k_t F| >= mu_s N), ``sliding`` the law's state and ``slip_rate``
+    the tangential velocity relative to the plate there.  Returns the new shear
+    displacement, the law's new state and whether a reset (or a slip's start) happened."""
+    return law_friction_rule(kind, shear, sliding, penetration, normal, slip_rate, prm)

@@ -31,9 +31,10 @@ def prm_slots() -> dict[str, int]:
 # spring's displacement F (Cundall-Strack), the integral of (vx - V_d)^2 and the
 # compensation term of its Kahan sum (the integral runs over up to 1e12 steps), and the
 # energy balance: work done on the block, energy dissipated (dashpots and resets), energy
-# stored in the normal spring, and the stored energy at the start.
-Y_X, Y_Z, Y_VX, Y_VZ, Y_F, Y_PHI, Y_PHI_C, Y_WORK, Y_DISSIPATED, Y_E_NORMAL, Y_E_START = range(11)
-N_Y = 11
+# stored in the normal spring, and the stored energy at the start; the friction law's
+# state: 1.0 while the block slides under a law that holds the spring at a kinetic bound.
+Y_X, Y_Z, Y_VX, Y_VZ, Y_F, Y_PHI, Y_PHI_C, Y_WORK, Y_DISSIPATED, Y_E_NORMAL, Y_E_START, Y_SLIDING = range(12)
+N_Y = 12
 
 # Integer counters, int64 array ``cnt``: internal steps taken since the start (time is
 # t0 + n dt, never accumulated), Coulomb resets, the step at which the drive phase was

@@ -15,14 +15,15 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.variables import Boolean, Integer, Real, String
 
 from ..fmi import FmuFacade, fmu_class
-from ..interface import INPUTS
+from ..interface import INPUTS, reading_choices
 from ..models import parameters_for
 from ..settings import ModelError
 from .runner import CHAIN_PARAMETERS, Chain
 
 # The blocks' parameters the chain offers (model A's physics; the drive spring is the leaf
 # spring k_p; the single block's start and tolerance parameters do not apply).
-BLOCK_PARAMETERS = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "A", "omega", "dt")
+BLOCK_PARAMETERS = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "A", "omega", "dt", "mu_k",
+                    "v_w")
 AGGREGATES = {
     "mean_slip_velocity": ("Real", "delta_0/tau_0", "mean of the blocks' slip velocities vx"),
     "moment_rate": ("Real", "delta_0/tau_0", "potency rate: the sum of the blocks' slip velocities"),
@@ -69,6 +70,11 @@ class ChainFacade(FmuFacade):
             self._parameter(Real, fmu_name, f"{text} [{spec.unit}]")
         for name, (_, unit, text) in CHAIN_PARAMETERS.items():
             self._parameter(Real, name, f"{text} [{unit}]")
+        self.register_variable(Integer(
+            "friction_law", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description=f"each block's friction law: {reading_choices('friction_law')}",
+            getter=lambda: self.chain.settings.readings["friction_law"],
+            setter=lambda value: self._guard(self._set_friction_law, int(value))))
         self.register_variable(Boolean(
             "periodic", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description="periodic ends (the last block coupled to the first); else free ends",
@@ -113,6 +119,10 @@ class ChainFacade(FmuFacade):
         self._require_not_started("periodic")
         self.periodic = periodic
         self.chain.periodic = periodic
+
+    def _set_friction_law(self, value: int) -> None:
+        self._require_not_started("friction_law")
+        self.chain.settings.set_reading("friction_law", value)
 
     def _set_energy_balance(self, track: bool) -> None:
         self._require_not_started("energy_balance")
@@ -176,6 +186,7 @@ class ChainFacade(FmuFacade):
                 "plate_input": dict(self.plate_input), "input_changed": self._input_changed,
                 "parameters": {name: self.chain.parameter(name) for name in self._parameter_names()},
                 "periodic": self.periodic, "energy_balance": self.chain.energy_balance,
+                "friction_law": self.chain.settings.readings["friction_law"],
                 "catalog_file": self.catalog_file}
 
     def _parameter_names(self):
@@ -183,6 +194,7 @@ class ChainFacade(FmuFacade):
 
     def _restore(self, state: dict) -> None:
         chain = Chain(self.n_blocks, periodic=bool(state["periodic"]), energy_balance=bool(state["energy_balance"]),
+                      friction_law=int(state["friction_law"]),
                       **{name: float(value) for name, value in state["parameters"].items()})
         if state["chain"] is not None:
             chain.set_state(state["chain"])

@@ -5,7 +5,10 @@ A law is one module ``<axis prefix><name>.py`` in this package stating:
 * its docstring, whose first line is its summary in the FMU and the docs;
 * ``ID``: its value of the axis' Integer parameter (stable, never reused; 0 is the default);
 * its compiled functions, the same for every law of an axis (below);
-* optionally ``REFUSED_BY``: {integrator name: why it cannot run this law}.
+* optionally ``REFUSED_BY``: {integrator name: why it cannot run this law};
+* optionally ``PARAMETERS``: its own parameters (``parameters.Parameter``, read in the
+  kernels at ``layout.slot(name)``), offered by every variant, and ``check(parameters)``:
+  why the parameters cannot run the law, or None.
 
 The axes, their FMU parameter and the functions every law of the axis brings:
 
@@ -19,7 +22,9 @@ contact       ``contact_law``   force(delta, u_n, prm), elastic(delta, prm), dis
                                 in Python: rest(load, p) -> (secant stiffness, tangent
                                 stiffness, damping) at rest under the load (the start)
 friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F0, F1, prm),
-                                rule(F, delta, N_b, prm)
+                                rule(F, sliding, delta, N_b, u_t, prm) -> (F, sliding, reset):
+                                the rule at a new state, ``sliding`` the law's state
+                                (``layout.Y_SLIDING``), u_t the slip rate there
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N
 plate         (one law)         motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau),
                                 acceleration(A, omega, sin, ext_a)
@@ -102,6 +107,12 @@ def law(axis: str, value: int) -> Law:
     return LAWS[axis][value]
 
 
+def law_parameters() -> tuple:
+    """The laws' own parameters (``PARAMETERS`` of their modules), in the registry's order."""
+    return tuple(p for laws in LAWS.values() for law_ in laws.values()
+                 for p in getattr(law_.module, "PARAMETERS", ()))
+
+
 def encode(choices: dict) -> int:
     """The kind bits of a run's laws, from {parameter: value} (absent: the default)."""
     bits = 0
@@ -149,6 +160,6 @@ contact_conservative = _constant("contact", "CONSERVATIVE")
 friction_spring_force = _dispatch("friction", "spring_force", "shear, prm")
 friction_energy = _dispatch("friction", "energy", "shear, prm")
 friction_released = _dispatch("friction", "released", "before, after, prm")
-friction_rule = _dispatch("friction", "rule", "shear, penetration, bound_normal, prm")
+friction_rule = _dispatch("friction", "rule", "shear, sliding, penetration, bound_normal, slip_rate, prm")
 bound_normal = _dispatch("bound", "normal", "kind, contact_normal, x, t, prm")
 plate_motion = _dispatch("plate", "motion", "amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau")

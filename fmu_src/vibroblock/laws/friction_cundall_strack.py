@@ -32,12 +32,12 @@ def released(before, after, prm):
 
 
 @njit(inline="always")
-def rule(shear, penetration, bound_normal, prm):
+def rule(shear, sliding, penetration, bound_normal, slip_rate, prm):
     """F = 0 once detached, or when |k_t F| >= mu_s N_b.  Returns the new shear
-    displacement and whether a reset released a loaded spring (resets of an already
-    relaxed spring are not counted)."""
+    displacement, the law's state (none: 0) and whether a reset released a loaded spring
+    (resets of an already relaxed spring are not counted)."""
     if penetration <= 0.0:
-        return 0.0, False
+        return 0.0, 0.0, False
     if abs(prm[P_KT] * shear) >= prm[P_MUS] * bound_normal:
-        return 0.0, shear != 0.0
-    return shear, False
+        return 0.0, 0.0, shear != 0.0
+    return shear, 0.0, False

@@ -32,15 +32,15 @@ REFUSED_BY = {
 
 
 @njit(inline="always")
-def rule(shear, penetration, bound_normal, prm):
+def rule(shear, sliding, penetration, bound_normal, slip_rate, prm):
     """F = 0 once detached; |k_t F| > mu_s N_b scales F back to the bound (F = 0 where the
-    bound is not positive).  Returns the new shear displacement and whether the bound
-    was met by a loaded spring."""
+    bound is not positive).  Returns the new shear displacement, the law's state (none:
+    0) and whether the bound was met by a loaded spring."""
     if penetration <= 0.0:
-        return 0.0, False
+        return 0.0, 0.0, False
     limit = prm[P_MUS] * bound_normal
     if abs(prm[P_KT] * shear) > limit:
         if limit <= 0.0:  # nothing holds: as the paper's reset
-            return 0.0, shear != 0.0
-        return math.copysign(limit / prm[P_KT], shear), True
-    return shear, False
+            return 0.0, 0.0, shear != 0.0
+        return math.copysign(limit / prm[P_KT], shear), 0.0, True
+    return shear, 0.0, False

@@ -46,11 +46,19 @@ class Variant:
     name: str
     kind: int  # index in the registry; a compile-time constant of the kernels
     description: str
-    parameters: tuple[Parameter, ...]  # the FMU's parameters of this variant, in order
+    own_parameters: tuple[Parameter, ...]  # the common ones and the variant's, in the FMU's order
     profile: Callable
     load: Callable
     curvature: Callable
     module: ModuleType
+
+    @property
+    def parameters(self) -> tuple[Parameter, ...]:
+        """The FMU's parameters of this variant, in order: its own, then the laws' (every
+        variant offers them; asked for once the laws are registered, which import the
+        variants)."""
+        from ..laws import law_parameters
+        return self.own_parameters + law_parameters()
 
     @property
     def fmu_name(self) -> str:

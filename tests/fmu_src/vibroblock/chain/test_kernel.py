@@ -18,10 +18,12 @@ def _chain(n, **parameters):
     return Chain(n, **{("k_p" if k == "k_d" else k): v for k, v in parameters.items()})
 
 
-def test_a_chain_of_one_block_is_the_single_block_bit_for_bit():
-    """Same laws, same scheme, same arithmetic: every state slot and the energy residual."""
-    block = Block("A", "symplectic_euler", 0, True, **VIBRATED)
-    chain = _chain(1, energy_balance=True, **VIBRATED)
+@pytest.mark.parametrize("law", [{}, {"friction_law": 2, "mu_k": 0.3, "v_w": 0.5}])
+def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law):
+    """Same laws, same scheme, same arithmetic: every state slot and the energy residual
+    (under the paper's friction and under the kinetic law, whose state rides along)."""
+    block = Block("A", "symplectic_euler", 0, True, **VIBRATED, **law)
+    chain = _chain(1, energy_balance=True, **VIBRATED, **law)
     block.start()
     chain.start()
     for t in np.arange(1, 61) * 50.0:
@@ -29,6 +31,7 @@ def test_a_chain_of_one_block_is_the_single_block_bit_for_bit():
         chain.advance_to(t)
     assert block.counters["resets"] > 10  # the run exercised the friction rule
     assert chain.Y[0, :L.Y_E_START].tolist() == block.y[:L.Y_E_START].tolist()  # (the chain books E_start itself)
+    assert chain.Y[0, L.Y_SLIDING] == block.y[L.Y_SLIDING]
     assert chain.outputs()["energy_residual"] == block.outputs()["energy_residual"]
     assert chain.outputs()["coulomb_resets"] == block.counters["resets"]
 
