@@ -183,6 +183,18 @@ class FmuFacade(Fmi2Slave):
             self.log(f"internal error while restoring the FMU state: {exc!r}", Fmi2Status.error)
 
 
+class PlateInputs:
+    """The plate inputs of a facade (``plate_input``: name -> value): a value is checked
+    as it is set and applied at the next doStep (``_input_changed``)."""
+
+    def _set_input(self, name: str, value: float) -> None:
+        if not math.isfinite(value):
+            raise self.rejected[0](f"input {name} = {value!r} is not finite; the previous value "
+                                   f"{self.plate_input[name]!r} is kept")
+        self.plate_input[name] = float(value)
+        self._input_changed = True
+
+
 def fmu_class(facade: type):
     """Class decorator for an FMU script's ``class Name(Fmi2Slave)``: returns a class of
     that name built on ``facade`` (a subclass of ``FmuFacade``), with the script class's

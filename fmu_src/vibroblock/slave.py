@@ -17,7 +17,7 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variabil
 from pythonfmu.variables import Boolean, Integer, Real
 
 from .block import Block
-from .fmi import TIME_TOLERANCE, FmuFacade, fmu_class
+from .fmi import TIME_TOLERANCE, FmuFacade, PlateInputs, fmu_class
 from .interface import (CHOICES, DEFAULT_INTEGRATOR_TEXT, ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES,
                         OUTPUTS, reading_choices)
 from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
@@ -28,7 +28,7 @@ from .parameters import DEFAULT_INTEGRATOR, INTEGRATOR_OPTIONS, SCENE_OPTIONS
 from .settings import ModelError
 
 
-class BlockFacade(FmuFacade):
+class BlockFacade(PlateInputs, FmuFacade):
     """FMU facade over ``vibroblock.Block``."""
 
     model = "A"
@@ -129,13 +129,6 @@ class BlockFacade(FmuFacade):
                  f"the FMU's own core is {bundled}. Run the FMU in a process without that import.",
                  Fmi2Status.error)
         return False
-
-    def _set_input(self, name: str, value: float) -> None:
-        if not math.isfinite(value):
-            raise ModelError(f"input {name} = {value!r} is not finite; the previous value "
-                             f"{self.plate_input[name]!r} is kept")
-        self.plate_input[name] = float(value)
-        self._input_changed = True
 
     def _apply_input(self) -> None:
         if self._input_changed:

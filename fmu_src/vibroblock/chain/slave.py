@@ -9,12 +9,10 @@ The FMU script (``fmu_src/BlockChain.py``) is::
 """
 from __future__ import annotations
 
-import math
-
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.variables import Boolean, Integer, Real, String
 
-from ..fmi import FmuFacade, fmu_class
+from ..fmi import FmuFacade, PlateInputs, fmu_class
 from ..interface import INPUTS, reading_choices
 from ..models import parameters_for
 from ..settings import ModelError
@@ -43,7 +41,7 @@ CATALOG_TEXT = ("path of the event catalogue (CSV, one row per event, written as
                 "v_start and v_stop are stated in its first line); empty: no file (event_count still counts)")
 
 
-class ChainFacade(FmuFacade):
+class ChainFacade(PlateInputs, FmuFacade):
     """FMU facade over ``vibroblock.chain.Chain``."""
 
     n_blocks = 16
@@ -135,13 +133,6 @@ class ChainFacade(FmuFacade):
     def _require_not_started(self, name: str) -> None:
         if self.chain.started:
             raise ModelError(f"{name} cannot change during a run")
-
-    def _set_input(self, name: str, value: float) -> None:
-        if not math.isfinite(value):
-            raise ModelError(f"input {name} = {value!r} is not finite; the previous value "
-                             f"{self.plate_input[name]!r} is kept")
-        self.plate_input[name] = float(value)
-        self._input_changed = True
 
     # ------------------------------------------------------------------ outputs
     def _changed(self) -> None:
