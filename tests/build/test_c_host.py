@@ -164,6 +164,9 @@ CASES = {
     "default": ({}, None),
     "vibrated": ({"A": 0.5, "omega": 0.8, "integrator": 1}, None),
     "driven": ({"initial_state": 0}, (0.2, 1.3)),
+    # Every axis' last law, chosen through the Integer parameters.
+    "other_laws": ({"A": 0.5, "omega": 0.8, "integrator": 1, "contact_law": 3, "friction_law": 2, "mu_k": 0.3,
+                    "v_w": 0.5, "coulomb_normal": 2}, None),
 }
 
 

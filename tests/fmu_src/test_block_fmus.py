@@ -486,12 +486,19 @@ def test_two_instances_in_one_process_are_independent(extracted, fmu_log):
         assert reals(c, vr) == interleaved
 
 
+# Every axis' last law at once: the Hertz-Hunt-Crossley contact, the kinetic friction bound
+# with weakening, and the load-only Coulomb bound.
+OTHER_LAWS = {"contact_law": 3, "friction_law": 2, "mu_k": 0.3, "v_w": 0.5, "coulomb_normal": 2}
+
+
+@pytest.mark.parametrize("laws", [{}, OTHER_LAWS], ids=["paper", "other_laws"])
 @pytest.mark.parametrize("model", "ABC")
-def test_libcosim_runs_the_fmus_with_the_same_results_as_fmpy(fmu_path, model):
-    """A second FMI 2.0 master (DNV's libcosim, through libcosimpy)."""
+def test_libcosim_runs_the_fmus_with_the_same_results_as_fmpy(fmu_path, model, laws):
+    """A second FMI 2.0 master (DNV's libcosim, through libcosimpy), with the paper's laws
+    and with others chosen through the Integer parameters."""
     from harness.cosim.masters.libcosim import run_libcosim
 
-    settings = {**SCALED, "A": 0.9, "omega": 1.1, "initial_state": 2, "integrator": 1}
+    settings = {**SCALED, "A": 0.9, "omega": 1.1, "initial_state": 2, "integrator": 1, **laws}
     names = OUTPUTS + ["contact", "slip_count"]
     reference = simulate_fmu(fmu_path(model), stop_time=60.0, output_interval=0.1, start_values=settings)
     other = run_libcosim(fmu_path(model), start_values=settings, stop_time=60.0, step_size=0.1, outputs=names)
