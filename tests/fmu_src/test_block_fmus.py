@@ -582,3 +582,30 @@ def test_the_tangent_frame_fmu_equals_the_core(extracted, fmu_log):
     block.start()
     block.advance_to(5.0)
     assert got == [block.outputs()[n] for n in OUTPUTS]
+
+
+@pytest.mark.parametrize("value, message", [(-0.1, "mu_k = -0.1 is not admissible"),
+                                            (0.6, "must not exceed the static one")])
+def test_a_bad_kinetic_coefficient_gives_fmi2error_and_the_host_goes_on(extracted, fmu_log, value, message):
+    """A negative mu_k is refused as it is set (the last good value kept); one above mu_s
+    when the run starts, with friction_law = 2 chosen."""
+    md, unzipdir = extracted["A"]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="BlockA", instanceName="kinetic")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setInteger([vr["integrator"]], [1])
+        slave.setInteger([vr["friction_law"]], [2])
+        status = set_real(slave, vr["mu_k"], value)
+        if value < 0.0:
+            assert status == fmi2Error and slave.getReal([vr["mu_k"]]) == [0.4]
+            slave.exitInitializationMode()
+            assert do_step(slave, 0.0, 1.0) == fmi2OK
+        else:
+            assert status_of(lambda: slave.fmi2ExitInitializationMode(slave.component)) == fmi2Error
+            assert do_step(slave, 0.0, 1.0) == fmi2Error  # not initialized: refused, no crash
+        assert any(status == fmi2Error and message in text for _, status, _, text in fmu_log.records)
+    finally:
+        slave.freeInstance()
