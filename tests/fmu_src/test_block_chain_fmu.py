@@ -28,10 +28,12 @@ def test_fmpy_validation_reports_nothing_and_every_block_has_its_outputs(chain_f
     assert {f"x[{i}]" for i in range(1, 17)} <= names and "x[17]" not in names and "vx[16]" in names
 
 
-def test_outputs_and_catalogue_equal_the_cores(chain_fmu, tmp_path):
+@pytest.mark.parametrize("clusters", [False, True], ids=["chain_wide", "clusters"])
+def test_outputs_and_catalogue_equal_the_cores(chain_fmu, tmp_path, clusters):
     result, events = simulate_chain(chain_fmu, stop_time=15000.0, step_size=50.0, catalog=tmp_path / "events.csv",
-                                    start_values=SETTINGS, outputs=("event_count", "x[1]", "x[16]"))
-    chain = Chain(16, **SETTINGS)
+                                    start_values={**SETTINGS, "cluster_catalog": clusters},
+                                    outputs=("event_count", "x[1]", "x[16]"))
+    chain = Chain(16, clusters=clusters, **SETTINGS)
     chain.start()
     for t in result["time"][1:]:
         chain.advance_to(t)
@@ -40,6 +42,7 @@ def test_outputs_and_catalogue_equal_the_cores(chain_fmu, tmp_path):
     assert events["t_start"].tolist() == [e[0] for e in chain.events]
     assert events["first_block"].tolist() == [int(e[2]) + 1 for e in chain.events]  # 1-based, as x[i]
     assert "v_start = 0.3" in events.attrs["thresholds"] and "v_stop = 0.1" in events.attrs["thresholds"]
+    assert ("clusters" in events.attrs["thresholds"]) == clusters
 
 
 @pytest.fixture

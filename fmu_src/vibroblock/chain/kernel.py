@@ -26,11 +26,13 @@ from ..integrators.symplectic_euler import euler_step
 from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_SLIDING,
                       Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..unowned import data_pointer, row_pointer
+from .clusters import close, follow
 
 # The chain's own constants, float64 array ``chn``: coupling stiffness, periodic ends
-# (1.0) or free (0.0), and the slip velocities that start and end an event.
-H_KC, H_PERIODIC, H_V_START, H_V_STOP = range(4)
-N_CHN = 4
+# (1.0) or free (0.0), the slip velocities that start and end an event, and the
+# catalogue: chain-wide (0.0) or clusters (1.0, ``clusters``).
+H_KC, H_PERIODIC, H_V_START, H_V_STOP, H_CLUSTERS = range(5)
+N_CHN = 5
 # The open event and the catalogue's bookkeeping, float64 array ``evt``: an event is open
 # (1.0), its start time, first block, peak slip speed; events closed in all, rows of the
 # catalogue filled since the runner last emptied it, and the last event's potency.
@@ -38,9 +40,10 @@ E_OPEN, E_START, E_FIRST, E_PEAK, E_CLOSED, E_ROWS, E_LAST = range(7)
 N_EVT = 7
 # Per-block scratch, float64 array (N, N_SCRATCH): the coupling force of this step, the
 # position before it, the position when the open event started, whether the block has
-# slipped in the open event, and the Coulomb resets of the block so far.
-S_PUSH, S_X_BEFORE, S_X_AT_START, S_JOINED, S_RESETS = range(5)
-N_SCRATCH = 5
+# slipped in the open event, the Coulomb resets of the block so far, and for the cluster
+# catalogue the block's cluster now (slot + 1, 0 for none).
+S_PUSH, S_X_BEFORE, S_X_AT_START, S_JOINED, S_RESETS, S_LABEL = range(6)
+N_SCRATCH = 6
 # One row of the catalogue, float64 array (capacity, N_ROW): start and end time, first
 # block (0-based), blocks that slipped, potency (sum of their slips), peak slip speed.
 R_START, R_END, R_FIRST, R_BLOCKS, R_POTENCY, R_PEAK = range(6)
@@ -130,8 +133,22 @@ def catalogue(Y, chn, evt, scratch, rows, t, t1):
     return CATALOGUE_FULL if row + 1 >= rows.shape[0] else OK
 
 
+@njit(inline="always")
+def cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1):
+    """After a step from t to t1: follow the clusters of slipping blocks (``clusters``)
+    and close those no block slips in any more into ``rows``.  Returns CATALOGUE_FULL
+    when fewer rows are left than clusters could close at the next step."""
+    follow(Y, clu, scratch[:, S_LABEL], scratch[:, S_X_BEFORE], (chn[H_V_START], chn[H_V_STOP]), t,
+           chn[H_PERIODIC] != 0.0)
+    first_row = int(evt[E_ROWS])
+    row, last = close(clu, rows, first_row, t1)
+    if row > first_row:
+        evt[E_ROWS], evt[E_CLOSED], evt[E_LAST] = row, evt[E_CLOSED] + (row - first_row), last
+    return CATALOGUE_FULL if rows.shape[0] - row < clu.shape[0] else OK
+
+
 @njit(cache=True)
-def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, n_steps, track_energy):
+def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track_energy):
     """Advance the chain by up to n_steps grid steps.  Returns OK, CATALOGUE_FULL (the
     steps taken so far are stored: empty ``rows`` and call again) or NON_FINITE (the
     arrays are then partly advanced: the runner restores its copy)."""
@@ -156,7 +173,10 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, n_steps, track_ener
             scratch[i, S_RESETS] = step_block(kind, row_pointer(PRM, i), row_pointer(Y, i), (t, t1, dt),
                                               (pz0, pv0, pz1, pv1), scratch[i, S_PUSH], scratch[i, S_RESETS],
                                               track_energy)
-        status = catalogue(Y, chn, evt, scratch, rows, t, t1)
+        if chn[H_CLUSTERS] != 0.0:
+            status = cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1)
+        else:
+            status = catalogue(Y, chn, evt, scratch, rows, t, t1)
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         if status != OK:
             break

@@ -22,6 +22,7 @@ from ..laws import law
 from ..settings import ModelError, Settings
 from . import kernel as K
 from .catalog import CatalogFile, magnitude
+from .clusters import N_CLU
 
 GRID_TOLERANCE = 1e-6
 CATALOG_ROWS = 4096  # rows the kernel fills before the runner empties them
@@ -58,10 +59,13 @@ class Chain:
     """
 
     def __init__(self, n_blocks: int = 16, *, periodic: bool = False, energy_balance: bool = False,
-                 catalog_path: str | Path | None = None, **parameters):
+                 clusters: bool = False, catalog_path: str | Path | None = None, **parameters):
         if not (isinstance(n_blocks, (int, np.integer)) and n_blocks >= 1):
             raise ModelError(f"n_blocks = {n_blocks!r}: a chain has at least one block")
         self.n_blocks, self.periodic, self.energy_balance = int(n_blocks), bool(periodic), bool(energy_balance)
+        # The catalogue: chain-wide events (an event ends when every block is below v_stop),
+        # or clusters of slipping blocks connected in space and time (``chain.clusters``).
+        self.clusters = bool(clusters)
         self.chain_parameters = chain_defaults()
         block = dict(BLOCK_DEFAULTS)
         for name, value in parameters.items():
@@ -122,10 +126,11 @@ class Chain:
         if p["mu_s_spread"] > 0.0:
             draw = np.random.default_rng(int(p["seed"])).uniform(-1.0, 1.0, self.n_blocks)
             self.PRM[:, L.P_MUS] *= 1.0 + p["mu_s_spread"] * draw
-        self.chn = np.array([p["k_c"], float(self.periodic), p["v_start"], p["v_stop"]])
+        self.chn = np.array([p["k_c"], float(self.periodic), p["v_start"], p["v_stop"], float(self.clusters)])
         self.evt = np.zeros(K.N_EVT)
         self.scratch = np.zeros((self.n_blocks, K.N_SCRATCH))
-        self.rows = np.zeros((CATALOG_ROWS, K.N_ROW))
+        self.clu = np.zeros((self.n_blocks + 1, N_CLU + self.n_blocks) if self.clusters else (1, N_CLU))
+        self.rows = self._catalogue_rows()
         self.events: list[tuple] = []
         self.time = float(t0)
         plate_z = self.settings.parameters["A"] * math.sin(self.drv[L.D_PHASE])
@@ -146,6 +151,12 @@ class Chain:
         self.Y[:, L.Y_VX] = vx
         self.energy_at_start = self.stored_energy()
 
+    def _catalogue_rows(self):
+        """The rows the kernel fills before the runner empties them: a step of the cluster
+        catalogue can close a cluster per slot."""
+        rows = max(CATALOG_ROWS, 2 * (self.n_blocks + 1)) if self.clusters else CATALOG_ROWS
+        return np.zeros((rows, K.N_ROW))
+
     def set_plate_input(self, z: float, v: float, a: float) -> None:
         run_arrays.check_plate_input(z, v, a)
         self._require_started()
@@ -159,12 +170,13 @@ class Chain:
                              "the end time must be finite and later than the current time")
         t0, dt = self.drv[L.D_T0], self.drv[L.D_DT]
         target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
-        kept = (self.Y.copy(), self.cnt.copy(), self.evt.copy(), self.scratch.copy())
+        kept = (self.Y.copy(), self.cnt.copy(), self.evt.copy(), self.scratch.copy(), self.clu.copy())
         while self.cnt[L.C_STEP] < target:
             status = K.advance(self.settings.kind, self.Y, self.PRM, self.cnt, self.drv, self.chn, self.evt,
-                               self.scratch, self.rows, int(target - self.cnt[L.C_STEP]), self.energy_balance)
+                               self.scratch, self.rows, self.clu, int(target - self.cnt[L.C_STEP]),
+                               self.energy_balance)
             if status == K.NON_FINITE:
-                self.Y, self.cnt, self.evt, self.scratch = kept
+                self.Y, self.cnt, self.evt, self.scratch, self.clu = kept
                 raise ModelError(f"the chain's state became non-finite between t = {self.time!r} and {t_end!r} "
                                  f"(dt = {dt!r}): a smaller dt, or softer springs; the state at t = {self.time!r} "
                                  "is kept")
@@ -239,8 +251,14 @@ class Chain:
 
     def describe_thresholds(self) -> str:
         p = self.chain_parameters
-        return (f"event start: a block's |vx| > v_start = {p['v_start']:g}; end: every |vx| < v_stop = "
-                f"{p['v_stop']:g} (delta_0/tau_0); N = {self.n_blocks}, k_c = {p['k_c']:g}, "
+        if self.clusters:
+            rule = (f"events as clusters: a block slips from |vx| > v_start = {p['v_start']:g} until |vx| < "
+                    f"v_stop = {p['v_stop']:g}, slipping neighbours share a cluster, a cluster ends when none of "
+                    "its blocks slips")
+        else:
+            rule = (f"event start: a block's |vx| > v_start = {p['v_start']:g}; end: every |vx| < v_stop = "
+                    f"{p['v_stop']:g}")
+        return (f"{rule} (delta_0/tau_0); N = {self.n_blocks}, k_c = {p['k_c']:g}, "
                 f"k_p = {self.settings.parameters['k_d']:g}, dt = {self.settings.parameters['dt']:g}")
 
     # ------------------------------------------------------------------ state
@@ -249,14 +267,16 @@ class Chain:
         file is not part of it: it records events as they close)."""
         self._require_started()
         return {"n_blocks": self.n_blocks, "periodic": self.periodic, "energy_balance": self.energy_balance,
+                "clusters": self.clusters,
                 "time": self.time, "energy_at_start": self.energy_at_start, "events": list(self.events),
                 "chain_parameters": dict(self.chain_parameters), "settings": self.settings.to_dict(),
-                **{name: getattr(self, name).tolist() for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch")}}
+                **{name: getattr(self, name).tolist() for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch",
+                                                                   "clu")}}
 
     def set_state(self, state: dict) -> None:
         try:
             arrays = {name: np.ascontiguousarray(state[name], dtype=np.int64 if name == "cnt" else float)
-                      for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch")}
+                      for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch", "clu")}
             n_blocks = int(state["n_blocks"])
         except (KeyError, TypeError, ValueError) as exc:
             raise ModelError(f"not a valid chain state: {exc}") from None
@@ -265,9 +285,10 @@ class Chain:
         self.settings = Settings.from_dict(state["settings"], "A")
         self.chain_parameters = dict(state["chain_parameters"])
         self.periodic, self.energy_balance = bool(state["periodic"]), bool(state["energy_balance"])
+        self.clusters = bool(state["clusters"])
         for name, value in arrays.items():
             setattr(self, name, value)
-        self.rows = np.zeros((CATALOG_ROWS, K.N_ROW))
+        self.rows = self._catalogue_rows()
         self.events = [tuple(e) for e in state["events"]]
         self.time, self.energy_at_start = float(state["time"]), float(state["energy_at_start"])
         self.started = True

@@ -83,6 +83,11 @@ class ChainFacade(PlateInputs, FmuFacade):
                         "energy_residual)",
             getter=lambda: self.chain.energy_balance,
             setter=lambda value: self._guard(self._set_energy_balance, bool(value))))
+        self.register_variable(Boolean(
+            "cluster_catalog", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description="catalogue events as clusters of slipping blocks connected in space and time (two events at "
+                        "two places are two); else chain-wide (an event ends when every block is below v_stop)",
+            getter=lambda: self.chain.clusters, setter=lambda value: self._guard(self._set_clusters, bool(value))))
         self.register_variable(String(
             "catalog_file", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=CATALOG_TEXT, getter=lambda: self.catalog_file,
@@ -125,6 +130,10 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _set_energy_balance(self, track: bool) -> None:
         self._require_not_started("energy_balance")
         self.chain.energy_balance = track
+
+    def _set_clusters(self, clusters: bool) -> None:
+        self._require_not_started("cluster_catalog")
+        self.chain.clusters = clusters
 
     def _set_catalog_file(self, path: str) -> None:
         self._require_not_started("catalog_file")
@@ -177,7 +186,7 @@ class ChainFacade(PlateInputs, FmuFacade):
                 "plate_input": dict(self.plate_input), "input_changed": self._input_changed,
                 "parameters": {name: self.chain.parameter(name) for name in self._parameter_names()},
                 "periodic": self.periodic, "energy_balance": self.chain.energy_balance,
-                "friction_law": self.chain.settings.readings["friction_law"],
+                "friction_law": self.chain.settings.readings["friction_law"], "clusters": self.chain.clusters,
                 "catalog_file": self.catalog_file}
 
     def _parameter_names(self):
@@ -185,7 +194,7 @@ class ChainFacade(PlateInputs, FmuFacade):
 
     def _restore(self, state: dict) -> None:
         chain = Chain(self.n_blocks, periodic=bool(state["periodic"]), energy_balance=bool(state["energy_balance"]),
-                      friction_law=int(state["friction_law"]),
+                      friction_law=int(state["friction_law"]), clusters=bool(state["clusters"]),
                       **{name: float(value) for name, value in state["parameters"].items()})
         if state["chain"] is not None:
             chain.set_state(state["chain"])
