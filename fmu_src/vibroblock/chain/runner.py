@@ -17,8 +17,7 @@ import numpy as np
 from .. import layout as L
 from .. import run_arrays
 from ..initial_state import place
-from ..observation import contact_energy
-from ..laws import law
+from ..observation import contact_energy, stored_energy
 from ..settings import ModelError, Settings
 from . import kernel as K
 from .catalog import CatalogFile, magnitude
@@ -209,21 +208,18 @@ class Chain:
         return float(plate_after(self.drv, self.cnt, int(self.cnt[L.C_STEP]), 0.0)[0])
 
     def stored_energy(self, plate_z: float | None = None) -> float:
-        """Kinetic, leaf-spring, friction-spring and contact energy of every block, and the
-        coupling springs' energy, at the stored grid state."""
+        """Each block's stored energy as the single block books it (kinetic, leaf spring,
+        friction spring, contact: ``observation.stored_energy``), and the coupling springs',
+        at the stored grid state."""
         plate_z = self.plate_height() if plate_z is None else plate_z
-        p = self.settings.parameters
-        Y, t = self.Y, self.grid_time
-        friction = law("friction", self.settings.readings.get("friction_law", 0)).module.energy.py_func
+        Y, t, obs = self.Y, self.grid_time, np.zeros(L.N_OBS)
         total = 0.0
         for i in range(self.n_blocks):
-            x, vx, vz, shear = Y[i, L.Y_X], Y[i, L.Y_VX], Y[i, L.Y_VZ], Y[i, L.Y_F]
-            stretch = x - p["V_d"] * t
-            total += (0.5 * p["m"] * (vx * vx + vz * vz) + 0.5 * p["k_d"] * stretch * stretch
-                      + float(friction(shear, self.PRM[i])) + contact_energy(self.settings, self.PRM[i],
-                                                                             plate_z - Y[i, L.Y_Z]))
+            obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F] = Y[i, L.Y_X], Y[i, L.Y_VX], Y[i, L.Y_VZ], Y[i, L.Y_F]
+            obs[L.O_PENETRATION] = plate_z - Y[i, L.Y_Z]
+            total += stored_energy(self.settings, self.PRM[i], obs, t)
         bonds = np.diff(Y[:, L.Y_X])
-        if self.periodic and self.n_blocks > 2:
+        if self.periodic and self.n_blocks > 1:  # (two blocks with periodic ends: two springs between them)
             bonds = np.append(bonds, Y[0, L.Y_X] - Y[-1, L.Y_X])
         return total + 0.5 * self.chain_parameters["k_c"] * float(np.sum(bonds * bonds))
 

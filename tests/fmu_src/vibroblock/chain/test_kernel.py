@@ -90,13 +90,15 @@ def test_small_oscillations_of_stuck_blocks_ring_at_the_normal_mode_frequencies(
         assert chain.outputs()["coulomb_resets"] == 0
 
 
-def test_the_energy_balance_closes_at_first_order_in_dt():
+@pytest.mark.parametrize("n, periodic", [(4, False), (2, True)])
+def test_the_energy_balance_closes_at_first_order_in_dt(n, periodic):
     """Stored energy (blocks and coupling springs) - stored at start - work + dissipated:
     symplectic Euler's first-order error, halved with dt; a coupling energy left out of
-    the books would not shrink."""
+    the books would not shrink (two blocks with periodic ends: two springs between them)."""
     residuals = []
     for dt in (1e-2, 5e-3):
-        chain = _chain(4, energy_balance=True, k_c=1.0, mu_s_spread=0.2, seed=3, **{**VIBRATED, "dt": dt})
+        chain = _chain(n, energy_balance=True, periodic=periodic, k_c=1.0, mu_s_spread=0.2, seed=3,
+                       **{**VIBRATED, "dt": dt})
         chain.start()
         chain.advance_to(3000.0)
         outputs = chain.outputs()
