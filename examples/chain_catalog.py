@@ -24,6 +24,7 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockChain.fmu", *, stop_time=
                    out=ROOT / "out", seed=1) -> dict:
     """Run the chain and return its catalogue frame and statistics (also printed)."""
     import numpy as np
+    from fmpy import read_model_description
 
     from harness.chain.run import simulate_chain
     from harness.chain.statistics import b_value, recurrence_intervals, size_exponent
@@ -32,7 +33,7 @@ def run_experiment(fmu=ROOT / "build" / "fmus" / "BlockChain.fmu", *, stop_time=
     out.mkdir(parents=True, exist_ok=True)
     _, events = simulate_chain(fmu, stop_time=stop_time, step_size=100.0, catalog=out / "chain_catalog.csv",
                                start_values={"mu_s_spread": spread, "k_c": k_c, "seed": seed})
-    n_blocks = int(events.attrs["thresholds"].split("N = ")[1].split(",")[0])
+    n_blocks = sum(v.name.startswith("x[") for v in read_model_description(str(fmu)).modelVariables)
     whole = events[events.n_blocks == n_blocks]
     print(f"{len(events)} events in {stop_time:g} tau_0 ({events.attrs['thresholds']})")
     print(f"  {len(whole)} involve all {n_blocks} blocks, {int((events.n_blocks == 1).sum())} a single block")

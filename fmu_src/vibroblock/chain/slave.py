@@ -12,6 +12,7 @@ from __future__ import annotations
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.variables import Boolean, Integer, Real, String
 
+from .. import layout as L
 from ..fmi import FmuFacade, PlateInputs, fmu_class
 from ..interface import INPUTS, reading_choices
 from ..models import parameters_for
@@ -35,6 +36,7 @@ AGGREGATES = {
     "energy_residual": ("Real", "m_0 delta_0^2/tau_0^2",
                         "stored energy - stored at start - work + dissipated (energy_balance)"),
 }
+PER_BLOCK_SLOTS = {"x": L.Y_X, "vx": L.Y_VX}  # each output's slot of a block's state
 PER_BLOCK = {"x": "displacement of block {i} from its place in the unloaded chain [delta_0]",
              "vx": "slip velocity of block {i} [delta_0/tau_0]"}
 CATALOG_TEXT = ("path of the event catalogue (CSV, one row per event, written as events close; the thresholds "
@@ -157,7 +159,7 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _block_output(self, name: str, i: int) -> float:
         if not self.chain.started:
             return 0.0
-        return float(self.chain.Y[i, {"x": 0, "vx": 2}[name]])
+        return float(self.chain.Y[i, PER_BLOCK_SLOTS[name]])
 
     # ------------------------------------------------------------------ facade hooks
     def _is_started(self) -> bool:
