@@ -109,7 +109,7 @@ class Block:
         if not math.isfinite(t0):
             raise ModelError(f"start time {t0!r} is not finite")
         self.settings.check(self.frozen_released)
-        self.y, self.cnt, self.drv, self.prm = run_arrays.fresh(self.parameters, t0)
+        self.y, self.cnt, self.drv, self.prm = run_arrays.fresh(self.parameters, t0, self.settings.readings)
         self.obs = np.zeros(L.N_OBS)
         self._native.ready = 0
         self.time = t0

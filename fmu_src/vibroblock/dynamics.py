@@ -177,9 +177,10 @@ def coulomb_bound(kind, normal, x, t, prm):
 
 
 @njit(inline="always")
-def friction_rule(kind, shear, sliding, penetration, normal, slip_rate, prm):
+def friction_rule(kind, shear, state, penetration, normal, slip_rate, h, prm):
     """The friction law's rule at a new state (``laws``: friction; the paper's: F = 0 once
-    detached, or when |k_t F| >= mu_s N), ``sliding`` the law's state and ``slip_rate``
-    the tangential velocity relative to the plate there.  Returns the new shear
-    displacement, the law's new state and whether a reset (or a slip's start) happened."""
-    return law_friction_rule(kind, shear, sliding, penetration, normal, slip_rate, prm)
+    detached, or when |k_t F| >= mu_s N) at the end of a step of length h, ``state`` the
+    law's state and ``slip_rate`` the tangential velocity relative to the plate there.
+    Returns the new shear displacement, the law's new state and whether a reset (or a
+    slip's start) happened."""
+    return law_friction_rule(kind, shear, state, penetration, normal, slip_rate, h, prm)

@@ -9,7 +9,7 @@ serialised whole (FMU state) and handed to compiled kernels without conversion.
 # by ``slot`` in the order the variants are registered.
 COMMON_PRM_NAMES = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "rtol", "atol", "max_jump")
 P_M, P_G, P_KN, P_KT, P_GN, P_GT, P_MUS, P_KD, P_VD, P_RTOL, P_ATOL, P_MAX_JUMP = range(len(COMMON_PRM_NAMES))
-N_PRM = 24  # capacity: common slots + every registered variant's own parameters
+N_PRM = 32  # capacity: common slots + every registered variant's own parameters
 _PRM_SLOTS = {name: i for i, name in enumerate(COMMON_PRM_NAMES)}
 
 
@@ -32,8 +32,9 @@ def prm_slots() -> dict[str, int]:
 # compensation term of its Kahan sum (the integral runs over up to 1e12 steps), and the
 # energy balance: work done on the block, energy dissipated (dashpots and resets), energy
 # stored in the normal spring, and the stored energy at the start; the friction law's
-# state: 1.0 while the block slides under a law that holds the spring at a kinetic bound.
-Y_X, Y_Z, Y_VX, Y_VZ, Y_F, Y_PHI, Y_PHI_C, Y_WORK, Y_DISSIPATED, Y_E_NORMAL, Y_E_START, Y_SLIDING = range(12)
+# state (its ``rule`` says what it holds: whether the block slides under a kinetic bound,
+# the rate-and-state variable theta, or nothing).
+Y_X, Y_Z, Y_VX, Y_VZ, Y_F, Y_PHI, Y_PHI_C, Y_WORK, Y_DISSIPATED, Y_E_NORMAL, Y_E_START, Y_FRICTION_STATE = range(12)
 N_Y = 12
 
 # Integer counters, int64 array ``cnt``: internal steps taken since the start (time is

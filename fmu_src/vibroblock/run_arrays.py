@@ -8,12 +8,14 @@ import numpy as np
 
 from . import layout as L
 from .integrators.plate import reduced_phase
+from .laws import initial_friction_state
 from .settings import ModelError
 
 
-def fresh(parameters: dict, t0: float):
+def fresh(parameters: dict, t0: float, readings: dict):
     """(y, cnt, drv, prm) at the start time t0: the parameters in their slots, the clock
-    and the drive (its phase reduced exactly), the state and counters zero."""
+    and the drive (its phase reduced exactly), the counters zero, the state zero but for
+    the friction law's own (``readings`` choose the law)."""
     prm = np.zeros(L.N_PRM)
     for name, index in L.prm_slots().items():
         prm[index] = parameters.get(name, 0.0)
@@ -21,7 +23,9 @@ def fresh(parameters: dict, t0: float):
     drv[L.D_T0], drv[L.D_DT] = t0, parameters["dt"]
     drv[L.D_AMP], drv[L.D_OMEGA] = parameters["A"], parameters["omega"]
     drv[L.D_PHASE], drv[L.D_EXT_T] = reduced_phase(0.0, parameters["omega"], t0), t0
-    return np.zeros(L.N_Y), np.zeros(L.N_CNT, dtype=np.int64), drv, prm
+    y = np.zeros(L.N_Y)
+    y[L.Y_FRICTION_STATE] = initial_friction_state(readings, parameters)
+    return y, np.zeros(L.N_CNT, dtype=np.int64), drv, prm
 
 
 def retune_drive(cnt, drv, amplitude: float, omega: float) -> None:

@@ -233,7 +233,7 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             shear = 0.0
         else:
             end_normal = _end_normal(kind, rigid, x, z, vx, vz, pz1, pv1, normal, prm)
-            shear, _, reset = friction_rule(kind, shear, 0.0, 1.0 if engaged else 0.0, end_normal, 0.0,
+            shear, _, reset = friction_rule(kind, shear, 0.0, 1.0 if engaged else 0.0, end_normal, 0.0, h,
                                             prm)  # (scenes run the paper's law, which has no state)
             slips += reset
         phi += d_phi

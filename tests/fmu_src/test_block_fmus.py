@@ -486,9 +486,10 @@ def test_two_instances_in_one_process_are_independent(extracted, fmu_log):
         assert reals(c, vr) == interleaved
 
 
-# Every axis' last law at once: the Hertz-Hunt-Crossley contact, the kinetic friction bound
-# with weakening, and the load-only Coulomb bound.
-OTHER_LAWS = {"contact_law": 3, "friction_law": 2, "mu_k": 0.3, "v_w": 0.5, "coulomb_normal": 2}
+# Every axis' last law at once: the Hertz-Hunt-Crossley contact, rate-and-state friction
+# with the slip law, and the load-only Coulomb bound.
+OTHER_LAWS = {"contact_law": 3, "friction_law": 4, "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0,
+              "coulomb_normal": 2}
 
 
 @pytest.mark.parametrize("laws", [{}, OTHER_LAWS], ids=["paper", "other_laws"])
@@ -607,5 +608,27 @@ def test_a_bad_kinetic_coefficient_gives_fmi2error_and_the_host_goes_on(extracte
             assert status_of(lambda: slave.fmi2ExitInitializationMode(slave.component)) == fmi2Error
             assert do_step(slave, 0.0, 1.0) == fmi2Error  # not initialized: refused, no crash
         assert any(status == fmi2Error and message in text for _, status, _, text in fmu_log.records)
+    finally:
+        slave.freeInstance()
+
+
+@pytest.mark.parametrize("name, value", [("rs_D_c", -1.0), ("rs_a", 0.0), ("rs_b", -0.01)])
+def test_a_bad_rate_and_state_parameter_gives_fmi2error_and_the_host_goes_on(extracted, fmu_log, name, value):
+    """Refused as it is set, the last good value kept; the run then starts and steps."""
+    md, unzipdir = extracted["A"]
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="BlockA", instanceName="rate_state")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    default = slave.getReal([vr[name]])
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setInteger([vr["integrator"]], [1])
+        slave.setInteger([vr["friction_law"]], [3])
+        assert set_real(slave, vr[name], value) == fmi2Error
+        assert slave.getReal([vr[name]]) == default
+        slave.exitInitializationMode()
+        assert do_step(slave, 0.0, 1.0) == fmi2OK
+        assert any(status == fmi2Error and name in text for _, status, _, text in fmu_log.records)
     finally:
         slave.freeInstance()

@@ -23,7 +23,7 @@ from ..dynamics import contact, coulomb_bound
 from ..integrators.fixed_step import NON_FINITE, OK, settle
 from ..integrators.plate import drive_sin_cos, next_sin_cos, plate_at, plate_moves
 from ..integrators.symplectic_euler import euler_step
-from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_SLIDING,
+from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
                       Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..unowned import data_pointer, row_pointer
 from .clusters import close, follow
@@ -82,11 +82,11 @@ def step_block(kind, prm, y, clock, plate, push, resets, track_energy):
     x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
         kind, prm, (x, z, vx, vz, shear), t, h, contact0, (pv0, pz1, pv1), track_energy, push)
     rule_normal = coulomb_bound(kind, contact1[5], x, t1, prm)
-    shear, sliding, resets, phi, phi_c, work, dissipated, e_normal = settle(
-        kind, prm, (shear, y[Y_SLIDING]), (contact1[0], rule_normal, contact1[2]), resets,
+    shear, friction_state, resets, phi, phi_c, work, dissipated, e_normal = settle(
+        kind, prm, (shear, y[Y_FRICTION_STATE]), (contact1[0], rule_normal, contact1[2], h), resets,
         (y[Y_PHI], y[Y_PHI_C], y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]), (d_phi, d_work, d_dissipated, d_normal),
         track_energy)
-    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_SLIDING] = x, z, vx, vz, shear, sliding
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_FRICTION_STATE] = x, z, vx, vz, shear, friction_state
     y[Y_PHI], y[Y_PHI_C], y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = phi, phi_c, work, dissipated, e_normal
     return resets
 

@@ -117,7 +117,7 @@ class Chain:
             raise ModelError(f"start time {t0!r} is not finite")
         self.settings.check()
         self._check()
-        y, self.cnt, self.drv, prm = run_arrays.fresh(self.settings.parameters, t0)
+        y, self.cnt, self.drv, prm = run_arrays.fresh(self.settings.parameters, t0, self.settings.readings)
         place(self.settings, prm, self.drv, y)
         p = self.chain_parameters
         self.Y = np.ascontiguousarray(np.tile(y, (self.n_blocks, 1)))

@@ -39,7 +39,7 @@ from ..laws import friction_released, friction_spring_force
 from ..unowned import data_pointer
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
-                      Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_SLIDING, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+                      Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from .plate import drive_sin_cos, next_sin_cos, phase_after, plate_after, plate_at, plate_moves
 
 OK, STOP = 0, 1
@@ -122,16 +122,16 @@ def book_energy(kind, prm, energies, increments, loaded, shear, track_energy):
 def settle(kind, prm, friction, rule, slips, sums, increments, track_energy):
     """End of every step of every scheme: the friction rule at the new state (``friction``
     = the shear displacement and the law's state, ``rule`` = the penetration, the bound's
-    N and the slip rate there), then the step's quadratures: ``sums`` = (phi, its
+    N and the slip rate there, and the step's length), then the step's quadratures: ``sums`` = (phi, its
     compensation, work, dissipated, normal spring energy), ``increments`` the step's (phi,
-    work, dissipated, normal spring).  Returns (F, sliding, slips, *sums)."""
+    work, dissipated, normal spring).  Returns (F, state, slips, *sums)."""
     phi, phi_c, work, dissipated, e_normal = sums
     loaded = shear = friction[0]
-    shear, sliding, reset = friction_rule(kind, shear, friction[1], rule[0], rule[1], rule[2], prm)
+    shear, state, reset = friction_rule(kind, shear, friction[1], rule[0], rule[1], rule[2], rule[3], prm)
     phi, phi_c = kahan_add(phi, phi_c, increments[0])
     work, dissipated, e_normal = book_energy(kind, prm, (work, dissipated, e_normal), increments[1:], loaded, shear,
                                              track_energy)
-    return shear, sliding, slips + reset, phi, phi_c, work, dissipated, e_normal
+    return shear, state, slips + reset, phi, phi_c, work, dissipated, e_normal
 
 
 @njit(cache=True)
@@ -145,7 +145,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     t0, dt = drv[D_T0], drv[D_DT]
     ctx = prepare(kind, flags, drv, prm, dt)
     moving = plate_moves(drv)
-    x, z, vx, vz, shear, sliding = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_SLIDING]
+    x, z, vx, vz, shear, friction_state = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_FRICTION_STATE]
     phi, phi_c = y[Y_PHI], y[Y_PHI_C]
     work, dissipated, e_normal = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
     n, slips = cnt[C_STEP], cnt[C_SLIPS]
@@ -175,8 +175,8 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
             break
         x, z, vx, vz, contact0 = x1, z1, vx1, vz1, contact1
         rule_normal = coulomb_bound(kind, rule_normal, x, t1, prm)  # the contact force, or the applied load
-        shear, sliding, slips, phi, phi_c, work, dissipated, e_normal = settle(
-            kind, prm, (shear1, sliding), (rule_pen, rule_normal, contact1[2]), slips,
+        shear, friction_state, slips, phi, phi_c, work, dissipated, e_normal = settle(
+            kind, prm, (shear1, friction_state), (rule_pen, rule_normal, contact1[2], dt), slips,
             (phi, phi_c, work, dissipated, e_normal), (d_phi, d_work, d_dissipated, d_normal), track_energy)
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         done += 1
@@ -184,7 +184,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
             return NON_FINITE
     if not is_finite_state(x, z, vx, vz, shear):
         return NON_FINITE
-    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_SLIDING] = x, z, vx, vz, shear, sliding
+    y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_FRICTION_STATE] = x, z, vx, vz, shear, friction_state
     y[Y_PHI], y[Y_PHI_C] = phi, phi_c
     y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = work, dissipated, e_normal
     cnt[C_STEP], cnt[C_SLIPS] = n, slips
@@ -229,7 +229,8 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
             rule_pen, rule_normal = state_contact[0], state_contact[5]
         rule_normal = coulomb_bound(kind, rule_normal, x, t + h, prm)
         loaded = shear
-        shear, _, reset = friction_rule(kind, shear, y[Y_SLIDING], rule_pen, rule_normal, state_contact[2], prm)
+        shear, _, reset = friction_rule(kind, shear, y[Y_FRICTION_STATE], rule_pen, rule_normal, state_contact[2], h,
+                                        prm)
         slips += reset
         phi += d_phi
         work, dissipated, e_normal = book_energy(kind, prm, (work, dissipated, e_normal),

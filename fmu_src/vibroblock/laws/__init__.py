@@ -22,9 +22,11 @@ contact       ``contact_law``   force(delta, u_n, prm), elastic(delta, prm), dis
                                 in Python: rest(load, p) -> (secant stiffness, tangent
                                 stiffness, damping) at rest under the load (the start)
 friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F0, F1, prm),
-                                rule(F, sliding, delta, N_b, u_t, prm) -> (F, sliding, reset):
-                                the rule at a new state, ``sliding`` the law's state
-                                (``layout.Y_SLIDING``), u_t the slip rate there
+                                rule(F, state, delta, N_b, u_t, h, prm) -> (F, state, reset):
+                                the rule at the end of a step of length h, ``state``
+                                the law's state (``layout.Y_FRICTION_STATE``), u_t the
+                                slip rate there; in Python: initial_state(parameters),
+                                the state at the start (absent: 0)
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N
 plate         (one law)         motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau),
                                 acceleration(A, omega, sin, ext_a)
@@ -63,9 +65,9 @@ class Axis:
 # (vibroblock.readings); bit 4 is free (the Coulomb bound's while it had two values).
 AXES = {
     "contact": Axis("contact", "contact_law", "contact_", 6, 2),
-    "friction": Axis("friction", "friction_law", "friction_", 8, 2),
-    "bound": Axis("bound", "coulomb_normal", "bound_", 10, 2),
-    "plate": Axis("plate", "plate_motion", "plate_", 12, 0),
+    "friction": Axis("friction", "friction_law", "friction_", 8, 3),
+    "bound": Axis("bound", "coulomb_normal", "bound_", 11, 2),
+    "plate": Axis("plate", "plate_motion", "plate_", 13, 0),
 }
 
 
@@ -108,9 +110,21 @@ def law(axis: str, value: int) -> Law:
 
 
 def law_parameters() -> tuple:
-    """The laws' own parameters (``PARAMETERS`` of their modules), in the registry's order."""
-    return tuple(p for laws in LAWS.values() for law_ in laws.values()
-                 for p in getattr(law_.module, "PARAMETERS", ()))
+    """The laws' own parameters (``PARAMETERS`` of their modules), in the registry's order,
+    each once (laws of one family, e.g. the two rate-and-state laws, share theirs)."""
+    seen: dict = {}
+    for laws in LAWS.values():
+        for law_ in laws.values():
+            for p in getattr(law_.module, "PARAMETERS", ()):
+                seen.setdefault(p.name, p)
+    return tuple(seen.values())
+
+
+def initial_friction_state(readings: dict, parameters: dict) -> float:
+    """The friction law's state at the start (``layout.Y_FRICTION_STATE``)."""
+    module = LAWS["friction"][int(readings.get("friction_law", 0))].module
+    start = getattr(module, "initial_state", None)
+    return float(start(parameters)) if start else 0.0
 
 
 def encode(choices: dict) -> int:
@@ -160,6 +174,6 @@ contact_conservative = _constant("contact", "CONSERVATIVE")
 friction_spring_force = _dispatch("friction", "spring_force", "shear, prm")
 friction_energy = _dispatch("friction", "energy", "shear, prm")
 friction_released = _dispatch("friction", "released", "before, after, prm")
-friction_rule = _dispatch("friction", "rule", "shear, sliding, penetration, bound_normal, slip_rate, prm")
+friction_rule = _dispatch("friction", "rule", "shear, state, penetration, bound_normal, slip_rate, h, prm")
 bound_normal = _dispatch("bound", "normal", "kind, contact_normal, x, t, prm")
 plate_motion = _dispatch("plate", "motion", "amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau")

@@ -32,7 +32,7 @@ def released(before, after, prm):
 
 
 @njit(inline="always")
-def rule(shear, sliding, penetration, bound_normal, slip_rate, prm):
+def rule(shear, state, penetration, bound_normal, slip_rate, h, prm):
     """F = 0 once detached, or when |k_t F| >= mu_s N_b.  Returns the new shear
     displacement, the law's state (none: 0) and whether a reset released a loaded spring
     (resets of an already relaxed spring are not counted)."""

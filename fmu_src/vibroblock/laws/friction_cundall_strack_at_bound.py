@@ -32,7 +32,7 @@ REFUSED_BY = {
 
 
 @njit(inline="always")
-def rule(shear, sliding, penetration, bound_normal, slip_rate, prm):
+def rule(shear, state, penetration, bound_normal, slip_rate, h, prm):
     """F = 0 once detached; |k_t F| > mu_s N_b scales F back to the bound (F = 0 where the
     bound is not positive).  Returns the new shear displacement, the law's state (none:
     0) and whether the bound was met by a loaded spring."""

@@ -18,7 +18,7 @@ stiff spring k_t instead of a set-valued force.
 
 The rule is applied at each step's end, so the mean kinetic force exceeds mu_d N_b by
 about k_t |u_t| dt / 2 (first order in dt).  The state: whether the block slides
-(``layout.Y_SLIDING``).  ``coulomb_resets`` counts the
+(``layout.Y_FRICTION_STATE``).  ``coulomb_resets`` counts the
 times the static bound broke (slips begun).  The energy the hold takes from the spring,
 k_t (F_before^2 - F_after^2) / 2, counts as dissipated.  ``adaptive`` and ``event_driven``
 refuse the law (they locate each breaking of the bound as an event and reset the spring).
@@ -64,7 +64,7 @@ def kinetic(slip_rate, prm):
 
 
 @njit(inline="always")
-def rule(shear, sliding, penetration, bound_normal, slip_rate, prm):
+def rule(shear, sliding, penetration, bound_normal, slip_rate, h, prm):
     """F = 0 once detached.  Stuck: the static bound |k_t F| > mu_s N_b starts a slip.
     Sliding (``sliding`` = 1): F held at sign(F) mu_d N_b / k_t while the slip goes on in
     F's direction, stuck again once it reverses.  Returns (F, sliding, whether a slip began)."""

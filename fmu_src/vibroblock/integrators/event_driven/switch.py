@@ -59,7 +59,7 @@ def start_side(kind, s, slips, prm, drv, th, tau_e):
             _release(kind, s, prm)
         return False, FREE, slips
     normal, armed = _contact_force_armed(kind, prm, pen, u_n, plate_a)
-    shear, _, reset = friction_rule(kind, s[Y_F], 0.0, TOUCHING, normal, 0.0, prm)  # (its law has no state)
+    shear, _, reset = friction_rule(kind, s[Y_F], 0.0, TOUCHING, normal, 0.0, 0.0, prm)  # (its law has no state)
     if reset:
         slips += 1
         _release(kind, s, prm)

@@ -18,10 +18,14 @@ def _chain(n, **parameters):
     return Chain(n, **{("k_p" if k == "k_d" else k): v for k, v in parameters.items()})
 
 
-@pytest.mark.parametrize("law", [{}, {"friction_law": 2, "mu_k": 0.3, "v_w": 0.5}])
+RATE_STATE = {"friction_law": 3, "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0}
+
+
+@pytest.mark.parametrize("law", [{}, {"friction_law": 2, "mu_k": 0.3, "v_w": 0.5}, RATE_STATE])
 def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law):
     """Same laws, same scheme, same arithmetic: every state slot and the energy residual
-    (under the paper's friction and under the kinetic law, whose state rides along)."""
+    (under the paper's friction, and under the kinetic and the rate-and-state laws, whose
+    state rides along)."""
     block = Block("A", "symplectic_euler", 0, True, **VIBRATED, **law)
     chain = _chain(1, energy_balance=True, **VIBRATED, **law)
     block.start()
@@ -29,9 +33,12 @@ def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law):
     for t in np.arange(1, 61) * 50.0:
         block.advance_to(t)
         chain.advance_to(t)
-    assert block.counters["resets"] > 10  # the run exercised the friction rule
+    if law is RATE_STATE:  # the run exercised the friction rule: theta moved (it has no resets)
+        assert abs(block.y[L.Y_FRICTION_STATE] - RATE_STATE["rs_theta_0"]) > 1.0
+    else:
+        assert block.counters["resets"] > 10
     assert chain.Y[0, :L.Y_E_START].tolist() == block.y[:L.Y_E_START].tolist()  # (the chain books E_start itself)
-    assert chain.Y[0, L.Y_SLIDING] == block.y[L.Y_SLIDING]
+    assert chain.Y[0, L.Y_FRICTION_STATE] == block.y[L.Y_FRICTION_STATE]
     assert chain.outputs()["energy_residual"] == block.outputs()["energy_residual"]
     assert chain.outputs()["coulomb_resets"] == block.counters["resets"]
 

@@ -1,0 +1,33 @@
+"""Rate-and-state friction (Dieterich-Ruina) with the aging law: dtheta/dt = 1 - V theta / D_c; the contact's spring k_t in series with the slipping interface.
+
+The friction coefficient, the interface's slip and the step are in ``laws.rate_state``.
+The aging (Dieterich) law heals a stationary contact: theta grows as the time of
+contact while V = 0, and relaxes to D_c / V at steady sliding, so mu_ss = mu_0 +
+(a - b) ln(V / V_0).  Over a step at the slip rate V it is integrated exactly:
+theta_1 = theta_0 exp(-V h / D_c) + h (1 - exp(-V h / D_c)) / (V h / D_c).
+"""
+import math
+
+from numba import njit
+
+from .friction_cundall_strack import energy, released, spring_force  # noqa: F401  (the same spring)
+from .rate_state import P_DC, PARAMETERS, REFUSED_BY, initial_state, interface_slip, relative_expm1  # noqa: F401
+
+ID = 3
+
+
+@njit(inline="always")
+def evolve(theta, slip_rate, h, prm):
+    """theta after h at the slip rate V >= 0 (exact for V held over the step)."""
+    x = slip_rate * h / prm[P_DC]
+    return theta * math.exp(-x) + h * relative_expm1(x)
+
+
+@njit(inline="always")
+def rule(shear, theta, penetration, bound_normal, slip_rate, h, prm):
+    """The interface's slip over the step, then theta's evolution at its rate.
+    Returns (F, theta, False): rate-and-state friction has no reset."""
+    shear, rate = interface_slip(shear, theta, penetration, bound_normal, h, prm)
+    if rate < 0.0:  # no contact: theta kept
+        return shear, theta, False
+    return shear, evolve(theta, rate, h, prm), False

@@ -1,0 +1,35 @@
+"""Rate-and-state friction (Dieterich-Ruina) with the slip law: dtheta/dt = -(V theta / D_c) ln(V theta / D_c); the contact's spring k_t in series with the slipping interface.
+
+The friction coefficient, the interface's slip and the step are in ``laws.rate_state``.
+The slip (Ruina) law evolves theta only by slip: a truly stationary contact does not
+heal, and theta relaxes to D_c / V at steady sliding (mu_ss as for the aging law), the
+log of V theta / D_c decaying exponentially over the slip D_c.  Over a step at the slip
+rate V it is integrated exactly: ln(V theta_1 / D_c) = ln(V theta_0 / D_c) exp(-V h / D_c).
+"""
+import math
+
+from numba import njit
+
+from .friction_cundall_strack import energy, released, spring_force  # noqa: F401  (the same spring)
+from .rate_state import P_DC, PARAMETERS, REFUSED_BY, initial_state, interface_slip  # noqa: F401
+
+ID = 4
+
+
+@njit(inline="always")
+def evolve(theta, slip_rate, h, prm):
+    """theta after h at the slip rate V >= 0 (exact for V held over the step)."""
+    if slip_rate <= 0.0:
+        return theta
+    x = slip_rate * h / prm[P_DC]
+    return theta * math.exp(math.log(slip_rate * theta / prm[P_DC]) * math.expm1(-x))
+
+
+@njit(inline="always")
+def rule(shear, theta, penetration, bound_normal, slip_rate, h, prm):
+    """The interface's slip over the step, then theta's evolution at its rate.
+    Returns (F, theta, False): rate-and-state friction has no reset."""
+    shear, rate = interface_slip(shear, theta, penetration, bound_normal, h, prm)
+    if rate < 0.0:  # no contact: theta kept
+        return shear, theta, False
+    return shear, evolve(theta, rate, h, prm), False

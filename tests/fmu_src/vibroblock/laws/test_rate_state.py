@@ -1,0 +1,187 @@
+"""Rate-and-state friction (friction_law = 3 aging, 4 slip): the closed forms, an
+independent solve_ivp reference, Ruina's critical stiffness, and the refusals."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from vibroblock import Block, layout as L
+from vibroblock.block import ModelError
+from vibroblock.laws import LAWS, law_parameters
+
+LAWS_RS = ("rate_state_aging", "rate_state_slip")
+A_, B_, DC, V0, MU0 = 0.01, 0.015, 0.1, 1e-3, 0.5
+
+
+def law_module(name):
+    return next(law for law in LAWS["friction"].values() if law.name == name).module
+
+
+def prm_array(k_t, **overrides):
+    values = {p.name: p.default for p in law_parameters()}
+    values.update(rs_a=A_, rs_b=B_, rs_D_c=DC, rs_V_0=V0, rs_mu_0=MU0, **overrides)
+    prm = np.zeros(L.N_PRM)
+    for name, value in values.items():
+        prm[L.slot(name)] = value
+    prm[L.P_KT] = k_t
+    return prm
+
+
+# ------------------------------------------------------ an independent reference (numpy)
+def reference_slip_rate(mu, theta, a=A_, b=B_):
+    """V from mu = a asinh(V / (2 V_0) exp(Psi / a)), Psi = mu_0 + b ln(V_0 theta / D_c)."""
+    psi = MU0 + b * np.log(V0 * theta / DC)
+    return 2.0 * V0 * np.exp(-psi / a) * np.sinh(mu / a)
+
+
+def reference_state_rate(law, v, theta):
+    if law == "rate_state_aging":
+        return 1.0 - v * theta / DC
+    return -(v * theta / DC) * np.log(v * theta / DC)
+
+
+def steady_mu(v, a=A_, b=B_):
+    """The regularized law at steady state theta = D_c / V (mu_0 + (a - b) ln(V / V_0) to
+    a relative exp(-2 Psi / a))."""
+    psi = MU0 + b * np.log(V0 / v)
+    return a * np.arcsinh(v / (2.0 * V0) * np.exp(psi / a))
+
+
+@pytest.mark.parametrize("law", LAWS_RS)
+def test_steady_sliding_obeys_mu_ss_of_the_printed_law(law):
+    """A velocity-strengthening block (a > b) driven at V_d slides steadily; the spring then
+    holds mu_ss N = (mu_0 + (a - b) ln(V_d / V_0)) N, the drive's stretch adds the dashpot."""
+    a, b, v_d, k_d, gamma_t = 0.015, 0.01, 1e-2, 1e-2, 5e-3
+    block = Block("A", "symplectic_euler", 0, False, dt=1e-2, friction_law=law, k_d=k_d, V_d=v_d,
+                  gamma_t=gamma_t, A=0.0, rs_a=a, rs_b=b, rs_D_c=DC, rs_V_0=V0, rs_mu_0=MU0, rs_theta_0=DC / V0)
+    block.start()
+    block.advance_to(30000.0)
+    out = block.outputs()
+    mu_ss = MU0 + (a - b) * math.log(v_d / V0)
+    assert out["vx"] == pytest.approx(v_d, rel=1e-6)
+    assert abs(out["friction_force"]) / out["normal_force"] == pytest.approx(mu_ss, rel=1e-9)
+    assert v_d * 30000.0 - out["x"] == pytest.approx((mu_ss + gamma_t * v_d) / k_d, rel=1e-6)
+
+
+def law_run(law, k_t, h, v1, v2, t_end):
+    """The rule driven as the velocity-step experiment: the spring's end (the block,
+    stiff machine k_t) moves at v1 until t = 0, at v2 after; mu(t) = k_t F / N."""
+    module = law_module(law)
+    prm = prm_array(k_t)
+    theta = DC / v1
+    shear = steady_mu(v1) / k_t
+    times = np.arange(1, int(round(t_end / h)) + 1) * h
+    mu = np.empty_like(times)
+    for i in range(len(times)):
+        shear, theta, reset = module.rule(shear + h * v2, theta, 1.0, 1.0, v2, h, prm)
+        assert not reset
+        mu[i] = k_t * shear
+    return times, mu
+
+
+def reference_run(law, k_t, v1, v2, times):
+    def rates(t, y):
+        mu, theta = y
+        v = reference_slip_rate(mu, theta)
+        return [k_t * (v2 - v), reference_state_rate(law, v, theta)]
+    solution = solve_ivp(rates, (0.0, times[-1]), [steady_mu(v1), DC / v1], method="Radau", t_eval=times,
+                         rtol=1e-11, atol=1e-14)
+    assert solution.success
+    return solution.y[0]
+
+
+@pytest.mark.parametrize("law", LAWS_RS)
+def test_a_velocity_step_follows_the_reference_and_the_closed_forms(law):
+    """A ten-fold step of the slip rate (stiff machine, k_t D_c / (a N) = 1000): mu jumps by
+    ~a ln(V2/V1) (the direct effect), then decays over a slip of a few D_c to
+    mu_ss(V2) = mu_ss(V1) + (a - b) ln(V2/V1).  The rule (backward Euler, first order)
+    matches a Radau solution of the same equations written independently, and its error
+    halves with the step."""
+    k_t, v1, v2, t_end = 100.0, 1e-3, 1e-2, 100.0
+    errors = []
+    for h in (2e-3, 1e-3):
+        times, mu = law_run(law, k_t, h, v1, v2, t_end)
+        reference = reference_run(law, k_t, v1, v2, times)
+        errors.append(np.abs(mu - reference).max())
+    assert errors[1] < 0.01 * A_ * math.log(v2 / v1)  # 1 % of the direct effect, in the elastic rise
+    assert 1.7 < errors[0] / errors[1] < 2.3  # first order
+    peak = mu.max() - steady_mu(v1)
+    assert peak == pytest.approx(A_ * math.log(v2 / v1), rel=0.05)
+    assert mu[-1] - steady_mu(v2) == pytest.approx(0.0, abs=1e-3 * A_)  # after a slip of 10 D_c
+    assert steady_mu(v2) - steady_mu(v1) == pytest.approx((A_ - B_) * math.log(v2 / v1), rel=1e-9)
+    slip_at_peak = v2 * times[np.argmax(mu)]
+    assert slip_at_peak < DC  # the peak comes within the first D_c of slip, the decay after it
+    after = np.argmax(mu)
+    half_way = times[after + np.argmax(mu[after:] - steady_mu(v2) < 0.5 * (mu.max() - steady_mu(v2)))] * v2
+    assert 0.1 * DC < half_way < 3.0 * DC
+
+
+@pytest.mark.parametrize("law", LAWS_RS)
+@pytest.mark.parametrize("ratio, unstable", [(0.5, True), (0.8, True), (1.25, False), (2.0, False)])
+def test_ruina_s_critical_stiffness_separates_stick_slip_from_steady_sliding(law, ratio, unstable):
+    """Quasi-static driving (inertia's correction m V^2 / (a N D_c) = 1e-3): below
+    k_c = (b - a) N / D_c the block stick-slips, above it the slip rate settles to V_d.
+    The loading stiffness is the drive spring in series with the contact's, k_d k_t / (k_d + k_t)."""
+    k_t, v_d = 0.28, 1e-3
+    k_c = (B_ - A_) * 1.0 / DC
+    k_d = 1.0 / (1.0 / (ratio * k_c) - 1.0 / k_t)
+    block = Block("A", "symplectic_euler", 0, False, dt=1e-2, friction_law=law, k_t=k_t, k_d=k_d, V_d=v_d,
+                  gamma_t=0.0, A=0.0, rs_a=A_, rs_b=B_, rs_D_c=DC, rs_V_0=v_d, rs_mu_0=MU0, rs_theta_0=DC / v_d)
+    block.start()
+    block.advance_to(34000.0)
+    late = []
+    for t in np.arange(34002.0, 40000.0, 2.0):
+        block.advance_to(t)
+        late.append(block.output("vx") / v_d)
+    if unstable:
+        assert max(late) > 10.0 and min(late) < 0.1
+    else:
+        assert max(late) - min(late) < 1e-4
+
+
+@pytest.mark.parametrize("law", LAWS_RS)
+@pytest.mark.parametrize("integrator", ["adaptive", "event_driven"])
+def test_the_event_locating_integrators_refuse_rate_and_state_saying_why(law, integrator):
+    block = Block("A", integrator, 0, False, friction_law=law)
+    with pytest.raises(ModelError, match="rate-and-state|spring with reset"):
+        block.start()
+
+
+@pytest.mark.parametrize("name, value", [("rs_a", -0.01), ("rs_a", 0.0), ("rs_b", -0.1), ("rs_D_c", 0.0),
+                                         ("rs_V_0", -1.0), ("rs_theta_0", 0.0), ("rs_mu_0", math.nan)])
+def test_bad_law_parameters_are_refused(name, value):
+    with pytest.raises(ModelError, match=name):
+        Block("A", "symplectic_euler", 0, False, friction_law="rate_state_aging", **{name: value})
+
+
+@pytest.mark.parametrize("law", LAWS_RS)
+@pytest.mark.parametrize("integrator", ["symplectic_euler", "rk4", "implicit_contact"])
+def test_the_energy_the_interface_s_slip_takes_is_booked_as_dissipated(law, integrator):
+    """Stick-slip (k = k_c / 2) through the first slips: the interface's slip is the only
+    dissipation (no dashpots), k_t (F_0^2 - F_1^2) / 2 per step; the balance closes to
+    rounding with the schemes whose own energy error is that small, to first order with
+    symplectic Euler."""
+    k_t = 0.28
+    k_d = 1.0 / (1.0 / (0.5 * (B_ - A_) / DC) - 1.0 / k_t)
+    block = Block("A", integrator, 0, True, dt=1e-2, friction_law=law, k_t=k_t, k_d=k_d, V_d=V0, gamma_t=0.0,
+                  gamma_n=0.07, A=0.0, rs_a=A_, rs_b=B_, rs_D_c=DC, rs_V_0=V0, rs_mu_0=MU0, rs_theta_0=DC / V0)
+    block.start()
+    block.advance_to(60000.0)
+    out = block.outputs()
+    assert out["energy_dissipated"] > 1.0
+    tolerance = 1e-2 if integrator == "symplectic_euler" else 1e-10
+    assert abs(out["energy_residual"]) < tolerance * out["energy_dissipated"]
+
+
+def test_theta_is_state_restored_with_the_run():
+    block = Block("A", "rk4", 0, False, dt=1e-2, friction_law="rate_state_slip", k_d=1e-2, V_d=1e-2, A=0.0,
+                  rs_D_c=DC, rs_V_0=V0, rs_theta_0=DC / V0)
+    block.start()
+    block.advance_to(800.0)
+    saved = block.get_state()
+    block.advance_to(1500.0)
+    first = block.outputs()
+    block.set_state(saved)
+    block.advance_to(1500.0)
+    assert block.outputs() == first
