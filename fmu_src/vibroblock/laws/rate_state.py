@@ -95,10 +95,13 @@ def coefficient(slip_rate, theta, prm):
 @njit
 def log_slip_rate(r, theta, prm):
     """ln V and d(ln V)/dr at r = k_t |F| / (a N_b) > 0, V = 2 V_0 exp(-Psi/a) sinh(r), in
-    logarithms (V overflows long before its logarithm does)."""
+    logarithms (V overflows long before its logarithm does); below r = 1e-3 by the series
+    ln sinh r = ln r + r^2/6, coth r = 1/r + r/3 (exp(-2r) rounds to 1 near r = 0)."""
+    log_scale = math.log(prm[P_V0]) - state_term(theta, prm) / prm[P_A]
+    if r < 1e-3:
+        return log_scale + LN2 + math.log(r) + r * r / 6.0, 1.0 / r + r / 3.0
     tail = math.exp(-2.0 * r)
-    log_v = math.log(prm[P_V0]) - state_term(theta, prm) / prm[P_A] + r + math.log1p(-tail)
-    return log_v, (1.0 + tail) / (1.0 - tail)
+    return log_scale + r + math.log1p(-tail), (1.0 + tail) / (1.0 - tail)
 
 
 @njit
@@ -134,6 +137,8 @@ def relaxed(shear, theta, normal, h, prm):
         r = r0 - math.exp(log_h + log_v0)
     else:  # where ln V ~ ln V_0 - Psi/a + r meets ln(r_0 / h)
         r = math.log(r0) - log_h - math.log(prm[P_V0]) + state_term(theta, prm) / prm[P_A]
+        if not 0.0 < r < r0:  # below r ~ 1 V is linear, 2 V_0 exp(-Psi/a) r
+            r = r0 / (1.0 + math.exp(log_h + math.log(2.0 * prm[P_V0]) - state_term(theta, prm) / prm[P_A]))
         if not 0.0 < r < r0:
             r = 0.5 * r0
     for _ in range(MAX_ITERATIONS):

@@ -48,6 +48,31 @@ def steady_mu(v, a=A_, b=B_):
     return a * np.arcsinh(v / (2.0 * V0) * np.exp(psi / a))
 
 
+@pytest.mark.parametrize("normal", [1e3, 1.0, 1e-3, 1e-30, 1e-200])
+@pytest.mark.parametrize("shear", [1e-300, 1e-20, 1e-9, 0.5, 1.785, 1.9, 10.0, 1e3])
+def test_the_interface_s_slip_solves_backward_euler_from_creep_to_overflow(shear, normal):
+    """F_1 + h V(F_1) = F_0 however small F (exp(-2 r) rounds to 1) or N_b (V overflows
+    by hundreds of decades): checked where it is representable, as ln(h V(F_1)) =
+    ln(F_0 - F_1) with V written out here (ln sinh r summed as numpy's logaddexp)."""
+    k_t, h, theta = 0.28, 1e-2, 5e4
+    module = law_module("rate_state_aging")
+    prm = prm_array(k_t)
+    f1, theta1, reset = module.rule(shear, theta, 1.0, normal, 0.0, h, prm)
+    assert 0.0 <= f1 <= shear and math.isfinite(theta1) and theta1 > 0.0 and not reset
+    psi = MU0 + B_ * math.log(V0 * theta / DC)
+    creep = h * k_t / (A_ * normal) * 2.0 * V0 * math.exp(-psi / A_)  # h dV/dF at F = 0
+    if shear / (1.0 + creep) < 1e-300:  # relaxed below the doubles' range (N_b ~ 0)
+        assert f1 < 1e-300
+        return
+    r = k_t * f1 / (A_ * normal)
+    log_sinh = np.logaddexp(r, -r) - math.log(2.0) + math.log(-math.expm1(-2.0 * r)) - math.log1p(math.exp(-2.0 * r))
+    log_hv = math.log(h) + math.log(2.0 * V0) - psi / A_ + log_sinh
+    if shear - f1 > 1e-12 * shear:  # the slip is resolved: the two sides agree, to F's rounding
+        assert log_hv == pytest.approx(math.log(shear - f1), abs=1e-10 + 4.4e-16 * shear / (shear - f1))
+    else:  # the slip is below F's rounding
+        assert math.exp(log_hv) <= 1e-12 * shear
+
+
 @pytest.mark.parametrize("law", LAWS_RS)
 def test_steady_sliding_obeys_mu_ss_of_the_printed_law(law):
     """A velocity-strengthening block (a > b) driven at V_d slides steadily; the spring then
