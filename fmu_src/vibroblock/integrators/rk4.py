@@ -18,34 +18,49 @@ def prepare(kind, flags, drv, prm, h):
     return 0
 
 
-# Compiled once and called by each of the four stages: inlining it four times into the
-# step cost three times the compile time (21-40 s against 8 s for rk4's kernels) and
-# gained nothing measurable, since its arguments are scalars and the parameters a pointer.
-@njit
-def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
+@njit(inline="always")
+def _rates(kind, prm, state, t, plate_v, contact_now, track_energy):
     """Accelerations, dF/dt, and the rates of the quadratures (phi, work, dissipation,
-    normal-spring energy) at one stage."""
-    pen, u_n, u_t, cos_a, sin_a, normal = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    normal-spring energy) at one stage, ``state`` = (x, z, vx, vz, F), whose contact
+    quantities ``contact_now`` (``dynamics.contact``) are known."""
+    x, z, vx, vz, shear = state
+    pen, u_n, u_t, cos_a, sin_a, normal = contact_now
     fx, fz = force(kind, x, t, pen > 0.0, pen, normal, u_t, cos_a, sin_a, shear, prm)
     d_shear = u_t if pen > 0.0 else 0.0
     rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz) for a point
     dv = rate_x - prm[P_VD]
     work = dissipation = storage = 0.0
     if track_energy:
-        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, pen > 0.0, (pen, u_n, u_t, cos_a, sin_a, normal),
-                                                  plate_v, prm)
+        work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, pen > 0.0, contact_now, plate_v, prm)
     return rate_x, rate_z, fx / prm[P_M], fz / prm[P_M], d_shear, dv * dv, work, dissipation, storage
 
 
+# Compiled once and called by stages 2-4: inlining it at every stage cost three to five
+# times the compile time (21-46 s against 8-9 s for rk4's advance kernel) for little
+# speed, since its arguments are scalars and the parameters a pointer.  The first stage's
+# rates are inlined into the step (one copy, some 3 s more compile time): called as a
+# function instead, they left rk4 on model B at 0.85-0.88x e856204's speed, not 1.0x.
+@njit
+def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
+    """``_rates`` at a stage's state, its contact quantities evaluated there."""
+    contact_now = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
+    return _rates(kind, prm, (x, z, vx, vz, shear), t, plate_v, contact_now, track_energy)
+
+
 @njit(inline="always")
-def rk4_step(kind, prm, state, t, h, plate, track_energy):
-    """One classical RK4 step of length h from ``state`` = (x, z, vx, vz, F), ``plate`` =
+def rk4_step(kind, prm, state, t, h, plate, contact0, track_energy):
+    """One classical RK4 step of length h from ``state`` = (x, z, vx, vz, F), whose contact
+    quantities at the plate's height and velocity at t are ``contact0``, ``plate`` =
     (height, velocity) at t, t + h/2 and t + h; returns the new state and the increments
     of phi, work, dissipation and normal-spring energy."""
     x, z, vx, vz, shear = state
     pz0, pv0, pz_half, pv_half, pz1, pv1 = plate[:6]
     half = 0.5 * h
-    rx1, rz1, ax1, az1, df1, p1, w1, d1, e1 = _rhs(kind, prm, x, z, vx, vz, shear, t, pz0, pv0, track_energy)
+    # The first stage is at the step's start, whose contact quantities the driver has
+    # already evaluated (at the previous step's end, with the same state and plate): one
+    # surface evaluation (sin, cos and a square root on a corrugated plate) fewer of the
+    # step's five, with bit-identical results.
+    rx1, rz1, ax1, az1, df1, p1, w1, d1, e1 = _rates(kind, prm, state, t, pv0, contact0, track_energy)
     vx2, vz2 = vx + half * ax1, vz + half * az1
     rx2, rz2, ax2, az2, df2, p2, w2, d2, e2 = _rhs(kind, prm, x + half * rx1, z + half * rz1, vx2, vz2,
                                                    shear + half * df1, t + half, pz_half, pv_half, track_energy)
@@ -73,7 +88,7 @@ def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy
     # sit at the times the plate was evaluated for.
     t, h, span = clock
     x, z, vx, vz, shear, d_phi, d_work, d_dissipated, d_normal = rk4_step(kind, prm, state, t, span, plate,
-                                                                          track_energy)
+                                                                          contact0, track_energy)
     pz1, pv1 = plate[4], plate[5]
     contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
     return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)
