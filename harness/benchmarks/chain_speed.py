@@ -8,7 +8,8 @@ Measured side by side in one process, compiled kernels warm, CPU seconds, best o
 1. the single block (``Block("A", "symplectic_euler")``, the chain's scheme), and chains
    of 1, 16, 64 and 256 blocks (``Chain``), all at the chain's defaults (scaled stick-slip
    drive, dt = 1e-2, mu_s spread 0.3), over the same simulated time: nanoseconds per
-   block-step and the ratio to the single block;
+   block-step and the ratio to the single block; then the same with ``rk4`` (the chain's
+   fourth-order scheme) beside the single block's ``rk4``;
 2. BlockChain.fmu through fmpy (16 blocks) at communication steps of 100, 10 and 1 tau_0,
    reading every output at each: the time per simulated tau_0 against the core's.
 
@@ -53,6 +54,14 @@ def core(t_end: float, rounds: int) -> float:
         seconds = _seconds(lambda n=n: Chain(n, **SPREAD), t_end, rounds)
         per = seconds / (steps * n) * 1e9
         print(f"   {f'Chain of {n}':24} {seconds:8.3f} {per:14.1f} {per / per_single:16.2f}")
+    single_rk4 = _seconds(lambda: Block("A", "rk4", 0, False, **BLOCK_DEFAULTS), t_end, rounds) / steps * 1e9
+    print(f"   {'single Block, rk4':24} {single_rk4 * steps / 1e9:8.3f} {single_rk4:14.1f} "
+          f"{single_rk4 / per_single:16.2f}")
+    for n in (16, 64):
+        seconds = _seconds(lambda n=n: Chain(n, integrator="rk4", **SPREAD), t_end, rounds)
+        per = seconds / (steps * n) * 1e9
+        print(f"   {f'Chain of {n}, rk4':24} {seconds:8.3f} {per:14.1f} {per / per_single:16.2f}  "
+              f"({per / single_rk4:.2f} x the single rk4)")
     return _seconds(lambda: Chain(16, **SPREAD), t_end, rounds) / t_end
 
 

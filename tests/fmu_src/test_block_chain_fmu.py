@@ -28,12 +28,13 @@ def test_fmpy_validation_reports_nothing_and_every_block_has_its_outputs(chain_f
     assert {f"x[{i}]" for i in range(1, 17)} <= names and "x[17]" not in names and "vx[16]" in names
 
 
-@pytest.mark.parametrize("clusters", [False, True], ids=["chain_wide", "clusters"])
-def test_outputs_and_catalogue_equal_the_cores(chain_fmu, tmp_path, clusters):
+@pytest.mark.parametrize("clusters, integrator", [(False, 0), (True, 0), (False, 1)],
+                         ids=["chain_wide", "clusters", "rk4"])
+def test_outputs_and_catalogue_equal_the_cores(chain_fmu, tmp_path, clusters, integrator):
     result, events = simulate_chain(chain_fmu, stop_time=15000.0, step_size=50.0, catalog=tmp_path / "events.csv",
-                                    start_values={**SETTINGS, "cluster_catalog": clusters},
+                                    start_values={**SETTINGS, "cluster_catalog": clusters, "integrator": integrator},
                                     outputs=("event_count", "x[1]", "x[16]"))
-    chain = Chain(16, clusters=clusters, **SETTINGS)
+    chain = Chain(16, clusters=clusters, integrator=integrator, **SETTINGS)
     chain.start()
     for t in result["time"][1:]:
         chain.advance_to(t)
@@ -55,9 +56,11 @@ def instance(chain_fmu, tmp_path, fmu_log):
     slave.freeInstance()
 
 
-def test_fmu_state_restores_the_run_bit_for_bit(instance):
+@pytest.mark.parametrize("integrator", [0, 1])
+def test_fmu_state_restores_the_run_bit_for_bit(instance, integrator):
     slave, vr = instance
     slave.setReal([vr["mu_s_spread"]], [0.3])
+    slave.setInteger([vr["integrator"]], [integrator])
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
     slave.exitInitializationMode()

@@ -1,14 +1,21 @@
 """The chain's compiled step: N single blocks, each stepped by the single block's own
 scheme and laws, coupled by the springs between neighbours; and the event catalogue.
 
-Each block is a model-A block (``Settings("A", "symplectic_euler")``): its slots of
-the per-block arrays ``Y`` (state, ``layout.Y_*``) and ``PRM`` (parameters, with its
-own mu_s) are handed, as row pointers (``unowned.row_pointer``), to the functions the
-single block's driver calls: ``symplectic_euler.euler_step`` and the driver's
-``settle`` (friction rule, quadratures).  The coupling enters each block's step as an
-extra horizontal force, computed from the positions at the step's start (the scheme's
-forces are all taken there).  So a chain of one block is the single block, bit for bit,
-and the physics of contact, friction and plate is written nowhere here.
+Each block is a model-A block (``Settings("A", integrator)``): its slots of the
+per-block arrays ``Y`` (state, ``layout.Y_*``) and ``PRM`` (parameters, with its own
+mu_s) are handed, as row pointers (``unowned.row_pointer``), to the functions the single
+block's schemes and driver call, and the driver's ``settle`` (friction rule,
+quadratures) ends every block's step.  Two schemes:
+
+* ``symplectic_euler`` (``symplectic_euler.euler_step``): the coupling enters each
+  block's step as an extra horizontal force, computed from the positions at the step's
+  start (the scheme's forces are all taken there).
+* ``rk4`` (the stage rates of ``rk4``): the four stages run over all blocks in lockstep,
+  each stage's coupling taken from the neighbours' positions at that stage, so the chain
+  is one fourth-order system and its energy balance closes as the single block's does.
+
+Either way a chain of one block is the single block, bit for bit, and the physics of
+contact, friction and plate is written nowhere here.
 
 x is each block's displacement from its place in the unloaded chain; the loader of
 block i sits at V_d t, so the drive spring of the single block is the chain's leaf
@@ -22,17 +29,20 @@ from numba import njit
 from ..dynamics import contact, coulomb_bound
 from ..integrators.fixed_step import NON_FINITE, OK, settle
 from ..integrators.plate import drive_sin_cos, next_sin_cos, plate_at, plate_moves
+from ..integrators.rk4 import stage_rates
 from ..integrators.symplectic_euler import euler_step
-from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
+from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_M, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
                       Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..unowned import data_pointer, row_pointer
 from .clusters import close, follow
 
 # The chain's own constants, float64 array ``chn``: coupling stiffness, periodic ends
-# (1.0) or free (0.0), the slip velocities that start and end an event, and the
-# catalogue: chain-wide (0.0) or clusters (1.0, ``clusters``).
-H_KC, H_PERIODIC, H_V_START, H_V_STOP, H_CLUSTERS = range(5)
-N_CHN = 5
+# (1.0) or free (0.0), the slip velocities that start and end an event, the
+# catalogue: chain-wide (0.0) or clusters (1.0, ``clusters``), and the scheme (the
+# integrator's id: SYMPLECTIC_EULER or RK4).
+H_KC, H_PERIODIC, H_V_START, H_V_STOP, H_CLUSTERS, H_SCHEME = range(6)
+N_CHN = 6
+SYMPLECTIC_EULER, RK4 = 0, 1
 # The open event and the catalogue's bookkeeping, float64 array ``evt``: an event is open
 # (1.0), its start time, first block, peak slip speed; events closed in all, rows of the
 # catalogue filled since the runner last emptied it, and the last event's potency.
@@ -41,9 +51,14 @@ N_EVT = 7
 # Per-block scratch, float64 array (N, N_SCRATCH): the coupling force of this step, the
 # position before it, the position when the open event started, whether the block has
 # slipped in the open event, the Coulomb resets of the block so far, and for the cluster
-# catalogue the block's cluster now (slot + 1, 0 for none).
-S_PUSH, S_X_BEFORE, S_X_AT_START, S_JOINED, S_RESETS, S_LABEL = range(6)
-N_SCRATCH = 6
+# catalogue the block's cluster now (slot + 1, 0 for none); for rk4 the block's position
+# at the current stage, its rates there (``rk4.stage_rates``: x, z, vx, vz, F, phi, work,
+# dissipation, normal spring) and their weighted sum over the stages so far.
+S_PUSH, S_X_BEFORE, S_X_AT_START, S_JOINED, S_RESETS, S_LABEL, S_STAGE_X = range(7)
+N_RATES = 9
+S_RATES = S_STAGE_X + 1
+S_SUM = S_RATES + N_RATES
+N_SCRATCH = S_SUM + N_RATES
 # One row of the catalogue, float64 array (capacity, N_ROW): start and end time, first
 # block (0-based), blocks that slipped, potency (sum of their slips), peak slip speed.
 R_START, R_END, R_FIRST, R_BLOCKS, R_POTENCY, R_PEAK = range(6)
@@ -52,21 +67,26 @@ CATALOGUE_FULL = 2  # a status: the steps so far are stored; empty the catalogue
 
 
 @njit(inline="always")
+def pull_on(positions, i, periodic):
+    """x_left - x + x_right - x of block i (free ends: no neighbour, no spring)."""
+    n_blocks = positions.shape[0]
+    x, pull = positions[i], 0.0
+    if i > 0 or periodic:
+        pull += positions[(i - 1) % n_blocks] - x
+    if i < n_blocks - 1 or periodic:
+        pull += positions[(i + 1) % n_blocks] - x
+    return pull
+
+
+@njit(inline="always")
 def couple(Y, chn, scratch):
-    """Each block's coupling force k_c (x_left - x + x_right - x) from the positions now,
-    free ends (no neighbour, no spring) or periodic; and the positions, kept as the
-    positions before the step."""
-    n_blocks = Y.shape[0]
-    k_c, periodic = chn[H_KC], chn[H_PERIODIC] != 0.0
-    for i in range(n_blocks):
-        x = Y[i, Y_X]
-        scratch[i, S_X_BEFORE] = x
-        pull = 0.0
-        if i > 0 or periodic:
-            pull += Y[(i - 1) % n_blocks, Y_X] - x
-        if i < n_blocks - 1 or periodic:
-            pull += Y[(i + 1) % n_blocks, Y_X] - x
-        scratch[i, S_PUSH] = k_c * pull
+    """Each block's coupling force k_c (x_left - x + x_right - x) from the positions now;
+    and the positions, kept as the positions before the step."""
+    periodic = chn[H_PERIODIC] != 0.0
+    for i in range(Y.shape[0]):
+        scratch[i, S_X_BEFORE] = Y[i, Y_X]
+    for i in range(Y.shape[0]):
+        scratch[i, S_PUSH] = chn[H_KC] * pull_on(scratch[:, S_X_BEFORE], i, periodic)
 
 
 @njit(inline="always")
@@ -81,6 +101,18 @@ def step_block(kind, prm, y, clock, plate, push, resets, track_energy):
     contact0 = contact(kind, x, z, vx, vz, pz0, pv0, prm)
     x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
         kind, prm, (x, z, vx, vz, shear), t, h, contact0, (pv0, pz1, pv1), track_energy, push)
+    return finish_block(kind, prm, y, (x, z, vx, vz, shear), contact1, (t1, h),
+                        (d_phi, d_work, d_dissipated, d_normal), resets, track_energy)
+
+
+@njit(inline="always")
+def finish_block(kind, prm, y, state, contact1, clock, increments, resets, track_energy):
+    """A block's step ends as the single block's does: the friction rule and the
+    quadratures (``fixed_step.settle``) at the new ``state``, whose contact quantities are
+    ``contact1``; ``clock`` = (t + h, h).  Stores the block's slots; returns its resets."""
+    x, z, vx, vz, shear = state
+    t1, h = clock
+    d_phi, d_work, d_dissipated, d_normal = increments
     rule_normal = coulomb_bound(kind, contact1[5], x, t1, prm)
     shear, friction_state, resets, phi, phi_c, work, dissipated, e_normal = settle(
         kind, prm, (shear, y[Y_FRICTION_STATE]), (contact1[0], rule_normal, contact1[2], h), resets,
@@ -89,6 +121,67 @@ def step_block(kind, prm, y, clock, plate, push, resets, track_energy):
     y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_FRICTION_STATE] = x, z, vx, vz, shear, friction_state
     y[Y_PHI], y[Y_PHI_C], y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL] = phi, phi_c, work, dissipated, e_normal
     return resets
+
+
+# rk4's stages: (offset from the step's start in units of the step, weight in the sum).
+STAGE_OFFSETS = (0.0, 0.5, 0.5, 1.0)
+STAGE_WEIGHTS = (1.0, 2.0, 2.0, 1.0)
+
+
+@njit(inline="always")
+def rk4_stage(kind, Y, PRM, chn, scratch, stage, clock, plate, track_energy):
+    """Stage ``stage`` of rk4 for every block: its state at the stage from the previous
+    stage's rates, the coupling from the neighbours' positions there, its rates
+    (``rk4.stage_rates`` plus the coupling), added to the weighted sum.  ``clock`` = (t, span);
+    ``plate`` = (height, velocity) at the stage."""
+    t, span = clock
+    offset = STAGE_OFFSETS[stage] * span
+    for i in range(Y.shape[0]):  # every stage position first: the coupling needs the neighbours'
+        scratch[i, S_STAGE_X] = Y[i, Y_X] + offset * scratch[i, S_RATES] if stage > 0 else Y[i, Y_X]
+    periodic = chn[H_PERIODIC] != 0.0
+    for i in range(Y.shape[0]):
+        prm = row_pointer(PRM, i)
+        rates = scratch[i, S_RATES:S_RATES + N_RATES]
+        state = (Y[i, Y_X], Y[i, Y_Z], Y[i, Y_VX], Y[i, Y_VZ], Y[i, Y_F])
+        if stage > 0:  # (the first stage at the state itself, to the bit)
+            state = (scratch[i, S_STAGE_X], state[1] + offset * rates[1], state[2] + offset * rates[2],
+                     state[3] + offset * rates[3], state[4] + offset * rates[4])
+        new = stage_rates(kind, prm, state[0], state[1], state[2], state[3], state[4], t + offset, plate[0],
+                          plate[1], track_energy)
+        push = chn[H_KC] * pull_on(scratch[:, S_STAGE_X], i, periodic)
+        weight = STAGE_WEIGHTS[stage]
+        for k in range(N_RATES):
+            value = new[k]
+            if k == 2 and push != 0.0:  # (a lone block adds nothing, not even the sign of a zero)
+                value += push / prm[P_M]
+            rates[k] = value
+            scratch[i, S_SUM + k] = value if stage == 0 else scratch[i, S_SUM + k] + weight * value
+
+
+@njit(inline="always")
+def rk4_step(kind, Y, PRM, chn, scratch, clock, plates, track_energy):
+    """One rk4 step of the whole chain, each block then finished as the single block's
+    (``finish_block``).  ``clock`` = (t, t + h, h, span); ``plates`` = (height, velocity)
+    at t, t + h/2 and t + h.  The block's own rk4 arithmetic, to the bit, where no
+    coupling acts."""
+    t, t1, h, span = clock
+    pz0, pv0, pzh, pvh, pz1, pv1 = plates
+    for i in range(Y.shape[0]):
+        scratch[i, S_X_BEFORE] = Y[i, Y_X]
+    rk4_stage(kind, Y, PRM, chn, scratch, 0, (t, span), (pz0, pv0), track_energy)
+    rk4_stage(kind, Y, PRM, chn, scratch, 1, (t, span), (pzh, pvh), track_energy)
+    rk4_stage(kind, Y, PRM, chn, scratch, 2, (t, span), (pzh, pvh), track_energy)
+    rk4_stage(kind, Y, PRM, chn, scratch, 3, (t, span), (pz1, pv1), track_energy)
+    sixth = span / 6.0
+    for i in range(Y.shape[0]):
+        prm, y = row_pointer(PRM, i), row_pointer(Y, i)
+        sums = scratch[i, S_SUM:S_SUM + N_RATES]
+        x, z = y[Y_X] + sixth * sums[0], y[Y_Z] + sixth * sums[1]
+        vx, vz, shear = y[Y_VX] + sixth * sums[2], y[Y_VZ] + sixth * sums[3], y[Y_F] + sixth * sums[4]
+        contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
+        scratch[i, S_RESETS] = finish_block(kind, prm, y, (x, z, vx, vz, shear), contact1, (t1, h),
+                                            (sixth * sums[5], sixth * sums[6], sixth * sums[7], sixth * sums[8]),
+                                            scratch[i, S_RESETS], track_energy)
 
 
 @njit(inline="always")
@@ -157,6 +250,8 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
     moving = plate_moves(drv)
     n = cnt[C_STEP]
     rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
+    half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
+    rk4 = chn[H_SCHEME] == RK4
     s, c = drive_sin_cos(drv, cnt, n)
     t = t0 + n * dt
     pz0, pv0 = plate_at(drv, s, c, t)
@@ -164,15 +259,21 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
     for _ in range(n_steps):
         n1 = n + 1
         t1 = t0 + n1 * dt
-        pz1, pv1 = pz0, pv0
+        pz1, pv1 = pzh, pvh = pz0, pv0
         if moving:
+            if rk4:  # the half step's plate, as the single block's driver takes it
+                pzh, pvh = plate_at(drv, s * half_c + c * half_s, c * half_c - s * half_s, t + 0.5 * dt)
             s, c = next_sin_cos(drv, cnt, n1, s, c, rot_s, rot_c)
             pz1, pv1 = plate_at(drv, s, c, t1)
-        couple(Y, chn, scratch)
-        for i in range(Y.shape[0]):
-            scratch[i, S_RESETS] = step_block(kind, row_pointer(PRM, i), row_pointer(Y, i), (t, t1, dt),
-                                              (pz0, pv0, pz1, pv1), scratch[i, S_PUSH], scratch[i, S_RESETS],
-                                              track_energy)
+        if rk4:
+            rk4_step(kind, Y, PRM, chn, scratch, (t, t1, dt, t1 - t), (pz0, pv0, pzh, pvh, pz1, pv1),
+                     track_energy)
+        else:
+            couple(Y, chn, scratch)
+            for i in range(Y.shape[0]):
+                scratch[i, S_RESETS] = step_block(kind, row_pointer(PRM, i), row_pointer(Y, i), (t, t1, dt),
+                                                  (pz0, pv0, pz1, pv1), scratch[i, S_PUSH], scratch[i, S_RESETS],
+                                                  track_energy)
         if chn[H_CLUSTERS] != 0.0:
             status = cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1)
         else:

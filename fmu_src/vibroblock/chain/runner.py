@@ -1,10 +1,11 @@
 """A chain of blocks on the vibrating plate (Burridge-Knopoff): the runner the
 BlockChain FMU and the harness drive, as ``Block`` is for one block.
 
-Every block is a model-A block with the single block's laws and scheme
-(``chain.kernel``); the chain adds the coupling springs k_c between neighbours, a leaf
-spring k_p (the single block's drive spring k_d) per block, per-block mu_s drawn from a
-seeded distribution, and the event catalogue.  Outputs are at the grid point at or
+Every block is a model-A block with the single block's laws and scheme,
+``symplectic_euler`` (default) or ``rk4`` (``chain.kernel``); the chain adds the
+coupling springs k_c between neighbours, a leaf spring k_p (the single block's drive
+spring k_d) per block, per-block mu_s drawn from a seeded distribution, and the event
+catalogue.  Outputs are at the grid point at or
 before the requested time (a communication step that is a multiple of dt hits the grid).
 """
 from __future__ import annotations
@@ -24,6 +25,10 @@ from .catalog import CatalogFile, magnitude
 from .clusters import N_CLU
 
 GRID_TOLERANCE = 1e-6
+# The schemes the chain's kernel runs, and the bound each puts on dt^2 k/m for the
+# stiffest spring (rk4's as the single block's check asks).
+SCHEMES = {"symplectic_euler": K.SYMPLECTIC_EULER, "rk4": K.RK4}
+STABLE = {"symplectic_euler": 1.0, "rk4": 4.0}
 CATALOG_ROWS = 4096  # rows the kernel fills before the runner empties them
 # The chain's own parameters: name -> (default, unit, description).  The blocks'
 # parameters are model A's, with the drive spring k_d called k_p (the leaf spring).
@@ -58,7 +63,8 @@ class Chain:
     """
 
     def __init__(self, n_blocks: int = 16, *, periodic: bool = False, energy_balance: bool = False,
-                 clusters: bool = False, catalog_path: str | Path | None = None, **parameters):
+                 clusters: bool = False, catalog_path: str | Path | None = None,
+                 integrator: str | int = "symplectic_euler", **parameters):
         if not (isinstance(n_blocks, (int, np.integer)) and n_blocks >= 1):
             raise ModelError(f"n_blocks = {n_blocks!r}: a chain has at least one block")
         self.n_blocks, self.periodic, self.energy_balance = int(n_blocks), bool(periodic), bool(energy_balance)
@@ -72,11 +78,22 @@ class Chain:
                 self.chain_parameters[name] = float(value)
             else:
                 block["k_d" if name == "k_p" else name] = value
-        self.settings = Settings("A", "symplectic_euler", 0, self.energy_balance, **block)
+        self.started = False
+        self.settings = Settings("A", integrator, 0, self.energy_balance, **block)
+        self.set_integrator(self.settings.integrator)
         self.catalog_file = CatalogFile(catalog_path) if catalog_path else None
         self.started = False
 
     # ------------------------------------------------------------------ settings
+    def set_integrator(self, integrator: str | int) -> None:
+        """``symplectic_euler`` (0, default) or ``rk4`` (1): the chain's kernel runs these two."""
+        if self.started:
+            raise ModelError("integrator cannot change during a run")
+        self.settings.set_integrator(integrator)
+        if self.settings.integrator not in SCHEMES:
+            chosen, self.settings.integrator = self.settings.integrator, "symplectic_euler"
+            raise ModelError(f"integrator = {chosen}: the chain runs symplectic_euler (0) or rk4 (1)")
+
     def set_parameter(self, name: str, value: float) -> None:
         if self.started:
             raise ModelError(f"{name} cannot change during a run")
@@ -107,9 +124,11 @@ class Chain:
         # (which Settings checks for k_n, k_t, k_d) with the stiffest coupling mode, 4 k_c.
         m, dt = self.settings.parameters["m"], self.settings.parameters["dt"]
         stiffest = self.settings.parameters["k_t"] + self.settings.parameters["k_d"] + 4.0 * p["k_c"]
-        if dt * dt * stiffest / m > 1.0:
+        bound = STABLE[self.settings.integrator]
+        if dt * dt * stiffest / m > bound:
             raise ModelError(f"dt = {dt!r} is too large for the coupling: dt^2 (k_t + k_p + 4 k_c)/m = "
-                             f"{dt * dt * stiffest / m:.3g} > 1; take dt <= {math.sqrt(m / stiffest):.3g}")
+                             f"{dt * dt * stiffest / m:.3g} > {bound:g} ({self.settings.integrator}); take "
+                             f"dt <= {math.sqrt(bound * m / stiffest):.3g}")
 
     # ------------------------------------------------------------------ running
     def start(self, t0: float = 0.0) -> None:
@@ -125,7 +144,8 @@ class Chain:
         if p["mu_s_spread"] > 0.0:
             draw = np.random.default_rng(int(p["seed"])).uniform(-1.0, 1.0, self.n_blocks)
             self.PRM[:, L.P_MUS] *= 1.0 + p["mu_s_spread"] * draw
-        self.chn = np.array([p["k_c"], float(self.periodic), p["v_start"], p["v_stop"], float(self.clusters)])
+        self.chn = np.array([p["k_c"], float(self.periodic), p["v_start"], p["v_stop"], float(self.clusters),
+                             float(SCHEMES[self.settings.integrator])])
         self.evt = np.zeros(K.N_EVT)
         self.scratch = np.zeros((self.n_blocks, K.N_SCRATCH))
         self.clu = np.zeros((self.n_blocks + 1, N_CLU + self.n_blocks) if self.clusters else (1, N_CLU))

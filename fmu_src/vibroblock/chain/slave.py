@@ -17,7 +17,7 @@ from ..fmi import FmuFacade, PlateInputs, fmu_class
 from ..interface import INPUTS, reading_choices
 from ..models import parameters_for
 from ..settings import ModelError
-from .runner import CHAIN_PARAMETERS, Chain
+from .runner import CHAIN_PARAMETERS, SCHEMES, Chain
 
 # The blocks' parameters the chain offers (model A's physics; the drive spring is the leaf
 # spring k_p; the single block's start and tolerance parameters do not apply).
@@ -75,6 +75,13 @@ class ChainFacade(PlateInputs, FmuFacade):
             description=f"each block's friction law: {reading_choices('friction_law')}",
             getter=lambda: self.chain.settings.readings["friction_law"],
             setter=lambda value: self._guard(self._set_friction_law, int(value))))
+        self.register_variable(Integer(
+            "integrator", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description="the chain's scheme: 0 = symplectic_euler (the paper's, first order), 1 = rk4 (fourth order "
+                        "between contact switches and resets, four force evaluations per step; its energy balance "
+                        "closes to rounding)",
+            getter=lambda: SCHEMES[self.chain.settings.integrator],
+            setter=lambda value: self._guard(self._set_integrator, int(value))))
         self.register_variable(Boolean(
             "periodic", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description="periodic ends (the last block coupled to the first); else free ends",
@@ -128,6 +135,10 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _set_friction_law(self, value: int) -> None:
         self._require_not_started("friction_law")
         self.chain.settings.set_reading("friction_law", value)
+
+    def _set_integrator(self, value: int) -> None:
+        self._require_not_started("integrator")
+        self.chain.set_integrator(value)
 
     def _set_energy_balance(self, track: bool) -> None:
         self._require_not_started("energy_balance")
@@ -189,6 +200,7 @@ class ChainFacade(PlateInputs, FmuFacade):
                 "parameters": {name: self.chain.parameter(name) for name in self._parameter_names()},
                 "periodic": self.periodic, "energy_balance": self.chain.energy_balance,
                 "friction_law": self.chain.settings.readings["friction_law"], "clusters": self.chain.clusters,
+                "integrator": self.chain.settings.integrator,
                 "catalog_file": self.catalog_file}
 
     def _parameter_names(self):
@@ -197,6 +209,7 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _restore(self, state: dict) -> None:
         chain = Chain(self.n_blocks, periodic=bool(state["periodic"]), energy_balance=bool(state["energy_balance"]),
                       friction_law=int(state["friction_law"]), clusters=bool(state["clusters"]),
+                      integrator=str(state["integrator"]),
                       **{name: float(value) for name, value in state["parameters"].items()})
         if state["chain"] is not None:
             chain.set_state(state["chain"])

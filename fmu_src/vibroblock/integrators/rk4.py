@@ -41,7 +41,7 @@ def _rates(kind, prm, state, t, plate_v, contact_now, track_energy):
 # rates are inlined into the step (one copy, some 3 s more compile time): called as a
 # function instead, they left rk4 on model B at 0.85-0.88x e856204's speed, not 1.0x.
 @njit
-def _rhs(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
+def stage_rates(kind, prm, x, z, vx, vz, shear, t, plate_z, plate_v, track_energy):
     """``_rates`` at a stage's state, its contact quantities evaluated there."""
     contact_now = contact(kind, x, z, vx, vz, plate_z, plate_v, prm)
     return _rates(kind, prm, (x, z, vx, vz, shear), t, plate_v, contact_now, track_energy)
@@ -62,13 +62,13 @@ def rk4_step(kind, prm, state, t, h, plate, contact0, track_energy):
     # step's five, with bit-identical results.
     rx1, rz1, ax1, az1, df1, p1, w1, d1, e1 = _rates(kind, prm, state, t, pv0, contact0, track_energy)
     vx2, vz2 = vx + half * ax1, vz + half * az1
-    rx2, rz2, ax2, az2, df2, p2, w2, d2, e2 = _rhs(kind, prm, x + half * rx1, z + half * rz1, vx2, vz2,
+    rx2, rz2, ax2, az2, df2, p2, w2, d2, e2 = stage_rates(kind, prm, x + half * rx1, z + half * rz1, vx2, vz2,
                                                    shear + half * df1, t + half, pz_half, pv_half, track_energy)
     vx3, vz3 = vx + half * ax2, vz + half * az2
-    rx3, rz3, ax3, az3, df3, p3, w3, d3, e3 = _rhs(kind, prm, x + half * rx2, z + half * rz2, vx3, vz3,
+    rx3, rz3, ax3, az3, df3, p3, w3, d3, e3 = stage_rates(kind, prm, x + half * rx2, z + half * rz2, vx3, vz3,
                                                    shear + half * df2, t + half, pz_half, pv_half, track_energy)
     vx4, vz4 = vx + h * ax3, vz + h * az3
-    rx4, rz4, ax4, az4, df4, p4, w4, d4, e4 = _rhs(kind, prm, x + h * rx3, z + h * rz3, vx4, vz4,
+    rx4, rz4, ax4, az4, df4, p4, w4, d4, e4 = stage_rates(kind, prm, x + h * rx3, z + h * rz3, vx4, vz4,
                                                    shear + h * df3, t + h, pz1, pv1, track_energy)
     sixth = h / 6.0
     return (x + sixth * (rx1 + 2.0 * rx2 + 2.0 * rx3 + rx4),

@@ -9,6 +9,7 @@ from vibroblock import Block
 from vibroblock import layout as L
 from vibroblock.chain import Chain
 from vibroblock.chain import runner
+from vibroblock.settings import ModelError
 
 # Stick-slip of the single block's benchmarks, on a vibrating plate (resets, detachments).
 VIBRATED = dict(A=0.3, omega=0.8, k_d=1e-2, V_d=1e-2, gamma_t=5e-3, dt=1e-2)
@@ -21,13 +22,14 @@ def _chain(n, **parameters):
 RATE_STATE = {"friction_law": 3, "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0}
 
 
+@pytest.mark.parametrize("integrator", ["symplectic_euler", "rk4"])
 @pytest.mark.parametrize("law", [{}, {"friction_law": 2, "mu_k": 0.3, "v_w": 0.5}, RATE_STATE])
-def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law):
+def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law, integrator):
     """Same laws, same scheme, same arithmetic: every state slot and the energy residual
     (under the paper's friction, and under the kinetic and the rate-and-state laws, whose
-    state rides along)."""
-    block = Block("A", "symplectic_euler", 0, True, **VIBRATED, **law)
-    chain = _chain(1, energy_balance=True, **VIBRATED, **law)
+    state rides along), with either scheme."""
+    block = Block("A", integrator, 0, True, **VIBRATED, **law)
+    chain = _chain(1, energy_balance=True, integrator=integrator, **VIBRATED, **law)
     block.start()
     chain.start()
     for t in np.arange(1, 61) * 50.0:
@@ -148,3 +150,38 @@ def test_a_full_catalogue_loses_no_event_and_changes_nothing(monkeypatch):
     assert small.events == big.events
     assert small.Y.tolist() == big.Y.tolist()
     assert small.outputs()["event_count"] == len(big.events)
+
+
+@pytest.mark.parametrize("law, tolerance", [({}, 1e-9), (RATE_STATE, 1e-12)], ids=["paper", "rate_state"])
+def test_with_rk4_the_energy_balance_closes_to_rounding_between_resets(law, tolerance):
+    """Eight heterogeneous blocks through stick-slip events, no vibration: rk4 is one
+    fourth-order system over all blocks (each stage's coupling from the stage's
+    positions).  The residual is the resets' first-order share under the paper's law
+    (1e-10 of the dissipated energy at dt = 1e-2, and a thirtieth of it at dt = 5e-3),
+    rounding under rate-and-state friction, which has no reset; symplectic Euler's is
+    of order dt (3e-3 here)."""
+    residuals = {}
+    for integrator in ("symplectic_euler", "rk4"):
+        chain = _chain(8, integrator=integrator, energy_balance=True, mu_s_spread=0.2, seed=1, **law)
+        chain.start()
+        chain.advance_to(20000.0)
+        outputs = chain.outputs()
+        assert outputs["event_count"] >= 10
+        residuals[integrator] = abs(outputs["energy_residual"]) / outputs["energy_dissipated"]
+    assert residuals["rk4"] < tolerance
+    assert residuals["symplectic_euler"] > 1e-4
+
+
+@pytest.mark.parametrize("integrator", ["implicit_contact", "adaptive", 4])
+def test_the_chain_runs_symplectic_euler_or_rk4_and_says_so(integrator):
+    with pytest.raises(ModelError, match="the chain runs symplectic_euler .0. or rk4 .1."):
+        Chain(3, integrator=integrator)
+
+
+def test_rk4_s_looser_step_bound_is_checked_with_the_coupling():
+    """rk4 asks dt^2 k/m <= 4 where symplectic Euler asks <= 1 (k: the stiffest mode's)."""
+    Chain(4, integrator="rk4", k_c=1.0, dt=0.9).start()
+    with pytest.raises(ModelError, match="> 1 .symplectic_euler.; take dt <= 0.483"):
+        Chain(4, integrator="symplectic_euler", k_c=1.0, dt=0.9).start()
+    with pytest.raises(ModelError, match="> 4 .rk4."):
+        Chain(4, integrator="rk4", k_c=1.0, dt=1.1).start()
