@@ -16,19 +16,25 @@ def by_kind(functions: dict, selector: str, arguments: str, takes_kind: bool = F
     ``functions`` maps each value of ``selector`` (an expression in ``kind``, e.g.
     ``"(kind >> 6) & 3"``) to a compiled function; ``arguments`` names their arguments
     (``takes_kind``: the functions take ``kind`` first themselves)."""
-    namespace = {f"_{value}": function for value, function in functions.items()}
-    values = sorted(functions)
+    # Values sharing one function (e.g. every friction law's spring force) share one branch:
+    # each branch is inlined at every call site, and LLVM's time grows with the inlined size.
+    groups: dict[int, list[int]] = {}
+    for value in sorted(functions):
+        groups.setdefault(id(functions[value]), []).append(value)
+    branches = sorted(groups.values())
+    namespace = {f"_{values[0]}": functions[values[0]] for values in branches}
     passed = f"kind, {arguments}" if takes_kind else arguments
     lines = [f"def dispatch(kind, {arguments}):"]
-    if len(values) == 1:
-        lines.append(f"    return _{values[0]}({passed})")
+    if len(branches) == 1:
+        lines.append(f"    return _{branches[0][0]}({passed})")
     else:
         lines.append(f"    chosen = {selector}")
-        for i, value in enumerate(values[:-1]):  # one return: numba's inliner wants one
-            lines.append(f"    {'if' if i == 0 else 'elif'} chosen == {value}:")
-            lines.append(f"        result = _{value}({passed})")
+        for i, values in enumerate(branches[:-1]):  # one return: numba's inliner wants one
+            test = " or ".join(f"chosen == {value}" for value in values)
+            lines.append(f"    {'if' if i == 0 else 'elif'} {test}:")
+            lines.append(f"        result = _{values[0]}({passed})")
         lines.append("    else:")
-        lines.append(f"        result = _{values[-1]}({passed})")
+        lines.append(f"        result = _{branches[-1][0]}({passed})")
         lines.append("    return result")
     exec("\n".join(lines), namespace)  # noqa: S102 - source built from the registries' integer keys only
     # Inlined into its callers: a call of a separately compiled function would pass its

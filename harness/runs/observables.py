@@ -46,9 +46,11 @@ Definitions
   phi > threshold otherwise; "sliding" if it keeps up with the drive
   (drift velocity >= half of V_d); "jammed" if it neither slips nor keeps up while the
   drive spring's stretch V_d t - x grows and ends beyond the flat surface's Coulomb
-  limit mu_s N0 / k_d (the paper's slip length, N0 = m g or P_l): held by more than
-  friction on a flat plate could hold, i.e. self-locked on a flank (docs/physics.md,
-  "Self-locking"); else "stuck": no slip and no sliding in a window shorter than a
+  limit mu_s N0 / k_d (the paper's slip length, N0 = m g or P_l), and friction can
+  self-lock where it sits: a tangential spring (k_t > 0) on a flank rising along the
+  pull with tan(alpha) >= 1 / mu_s (docs/physics.md, "Self-locking"); else "stuck"
+  (which includes a block held beyond that limit by the slope and load alone, e.g. the
+  stable rest of Eq. (9) with k_t = 0): no slip and no sliding in a window shorter than a
   stick phase (phi = 1 for a block at rest, below any sensible threshold): lengthen
   the window to classify.  A block mostly in contact is judged by phi, as in the
   paper: its velocity cannot tell a stick from a slip when the tangential spring rings
@@ -192,7 +194,25 @@ def refine(regime: str, ds: xr.Dataset, win: Window, contact: float, slips: int 
     stretch_start = v_d * time[win.first] - x[win.first]
     stretch_end = v_d * time[win.last] - x[win.last]
     growing = abs(stretch_end) > abs(stretch_start)
-    return JAMMED if growing and abs(stretch_end) > nominal_slip_length(ds.attrs) else STUCK
+    if not (growing and abs(stretch_end) > nominal_slip_length(ds.attrs)):
+        return STUCK
+    return JAMMED if self_locking(ds, win, v_d) else STUCK
+
+
+def self_locking(ds: xr.Dataset, win: Window, v_d: float) -> bool:
+    """Whether friction can hold the block where it sits against the drive's pull however
+    large the pull: a tangential spring (k_t > 0) and a flank rising along the pull with
+    tan(alpha) >= 1 / mu_s (docs/physics.md, "Self-locking").  A block held beyond the
+    flat plate's Coulomb limit anywhere else (e.g. balanced on a flank by the drive
+    spring and the load alone, Eq. (9), with k_t = 0) is not held by friction: stuck."""
+    if float(ds.attrs.get("k_t", 1.0)) <= 0.0 or float(ds.attrs.get("mu_s", 0.0)) <= 0.0:
+        return False
+    alpha_end, _ = slope_angles(ds, win)
+    if math.isnan(alpha_end):  # a flat plate: its Coulomb bound does not grow with the pull
+        return False
+    uphill = alpha_end * math.copysign(1.0, v_d) > 0.0
+    # (alpha comes in degrees: tan(alpha) mu_s = 1 is met to rounding)
+    return uphill and math.tan(math.radians(abs(alpha_end))) * float(ds.attrs["mu_s"]) >= 1.0 - 1e-12
 
 
 def slope_angles(ds: xr.Dataset, win: Window) -> tuple[float, float]:

@@ -490,19 +490,22 @@ def test_two_instances_in_one_process_are_independent(extracted, fmu_log):
 # with the slip law, and the load-only Coulomb bound.
 OTHER_LAWS = {"contact_law": 3, "friction_law": 4, "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0,
               "coulomb_normal": 2}
+LAW_NAMES = {"contact_law": "hertz_hunt_crossley", "friction_law": "rate_state_slip", "coulomb_normal": "load_only"}
 
 
 @pytest.mark.parametrize("laws", [{}, OTHER_LAWS], ids=["paper", "other_laws"])
 @pytest.mark.parametrize("model", "ABC")
 def test_libcosim_runs_the_fmus_with_the_same_results_as_fmpy(fmu_path, model, laws):
     """A second FMI 2.0 master (DNV's libcosim, through libcosimpy), with the paper's laws
-    and with others chosen through the Integer parameters."""
+    and with others chosen through the Integer parameters: by value in fmpy, by name (the
+    model description's) in libcosim."""
     from harness.cosim.masters.libcosim import run_libcosim
 
     settings = {**SCALED, "A": 0.9, "omega": 1.1, "initial_state": 2, "integrator": 1, **laws}
     names = OUTPUTS + ["contact", "slip_count"]
     reference = simulate_fmu(fmu_path(model), stop_time=60.0, output_interval=0.1, start_values=settings)
-    other = run_libcosim(fmu_path(model), start_values=settings, stop_time=60.0, step_size=0.1, outputs=names)
+    by_name = {**settings, **{name: LAW_NAMES[name] for name in laws if name in LAW_NAMES}}
+    other = run_libcosim(fmu_path(model), start_values=by_name, stop_time=60.0, step_size=0.1, outputs=names)
     np.testing.assert_array_equal(other["time"], reference["time"])
     # libcosim passes times as integer nanoseconds / 1e9: they can differ from fmpy's in
     # the last bit, which the FMU absorbs (it steps on its own grid of dt).

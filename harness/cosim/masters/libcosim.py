@@ -82,12 +82,13 @@ import subprocess
 import sys
 import tempfile
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from fmpy import read_model_description
 
+from ..fmu import FmuInterface
 from .errors import LibcosimError, SetupError
 
 __all__ = ["run_libcosim", "run_libcosim_system", "LibcosimError", "SetupError"]
@@ -154,6 +155,8 @@ class _Variable:
     vr: int
     type: str  # real | integer | boolean
     causality: str
+    # An Integer switch's named values, from its description ("0 = name, 1 = name").
+    choices: dict = field(default_factory=dict, compare=False)
 
     @property
     def key(self) -> str:
@@ -193,7 +196,8 @@ class _Instance:
             raise SetupError(f"{role}: {self.name}.{name} is of type {var.type}; "
                              "only Real, Integer and Boolean variables are supported")
         return _Variable(self.number, self.name, name, int(var.valueReference), kind,
-                         var.causality or "local")
+                         var.causality or "local",
+                         FmuInterface.parse_choices(var.description) if kind == "integer" else {})
 
 
 def _typed(var: _Variable, value: object, role: str) -> Value:
@@ -203,6 +207,11 @@ def _typed(var: _Variable, value: object, role: str) -> Value:
             return bool(value)
     elif isinstance(value, (bool, np.bool_)):
         pass
+    elif var.type == "integer" and isinstance(value, str):  # a switch's value by name
+        if value in var.choices:
+            return var.choices[value]
+        raise SetupError(f"{role}: {var.key} = {value!r} is not one of its named values "
+                         f"{sorted(var.choices) or '(it has none)'}")
     elif var.type == "integer":
         # a whole float is that int (``RunSettings.parameters`` holds numbers as floats)
         whole = isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer()
@@ -232,7 +241,8 @@ def run_libcosim(
     fmu_path: the ``.fmu`` file.
     start_values: variable name -> value for parameters and inputs, set before
         initialisation; the Python type must suit the variable (bool for Boolean,
-        int or a whole float for Integer, int or float for Real).
+        int, a whole float or a named value, e.g. "rate_state_slip", for Integer, int or
+        float for Real).
     stop_time, step_size, start_time: the communication grid, in seconds; see the
         module docstring for libcosim's nanosecond clock.
     outputs: names of the Real, Integer and Boolean variables to record.

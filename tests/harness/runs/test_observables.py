@@ -143,18 +143,33 @@ def test_contact_fraction_drift_and_classification():
     assert classify(1.0, 10.0, 0.01 * V_D, V_D) == STUCK
 
 
-def test_a_window_without_slips_and_without_drift_is_stuck_or_jammed_by_the_spring_stretch():
-    # The drive spring's stretch reaches 0.97 V_d 3000 = 29.1 at the end of the window:
-    # jammed when that is beyond mu_s m g / k_d (the flat plate's slip length), stuck below.
+def test_a_window_without_slips_and_without_drift_is_jammed_only_where_friction_can_self_lock():
+    """The drive spring's stretch reaches 0.97 V_d 3000 = 29.1 at the end of the window,
+    beyond the flat plate's slip length mu_s m g / k_d = 20.  Jammed only on a flank
+    rising along the pull with tan(alpha) >= 1/mu_s = 2 and a tangential spring; stuck
+    on a flat plate, on a gentler or a falling flank, with k_t = 0 (nothing can self-lock:
+    e.g. Eq. (9)'s stable rest), and below the slip length."""
     t = np.arange(0.0, 3000.0, 1.0)
     creeping = np.full_like(t, 0.03 * V_D)
     settings = ObservableSettings(transient=100.0)
-    short_stick = observe(dataset(t, creeping, k_d=0.5 / 20.0), settings)   # slip length 20 < 29.1
-    long_stick = observe(dataset(t, creeping, k_d=0.5 / 40.0), settings)    # slip length 40 > 29.1
-    assert short_stick.phi == pytest.approx(0.97**2) and short_stick.regime == JAMMED
-    assert long_stick.regime == STUCK and not long_stick.stick_slip
+    x_end = cumulative(t, creeping)[-1]
+
+    def regime(tan_alpha=None, **attrs):
+        if tan_alpha is not None:  # a corrugation whose slope under the block's last position is tan_alpha
+            omega_x = 1.0
+            attrs.update(omega_x=omega_x, A_x=tan_alpha / (omega_x * math.cos(omega_x * x_end)))
+        return observe(dataset(t, creeping, **{"k_d": 0.5 / 20.0, "k_t": 0.28, **attrs}), settings)
+
+    flank = regime(3.0)
+    assert flank.phi == pytest.approx(0.97**2) and flank.regime == JAMMED and not flank.stick_slip
+    assert regime(2.0).regime == JAMMED  # tan(alpha) = 1/mu_s: the bound grows as fast as the pull
+    assert regime(1.5).regime == STUCK
+    assert regime(-3.0).regime == STUCK  # a pull down the flank
+    assert regime(3.0, k_t=0.0).regime == STUCK
+    assert regime().regime == STUCK  # a flat plate
+    assert regime(3.0, k_d=0.5 / 40.0).regime == STUCK  # slip length 40 > 29.1
     # Confined by P_l (model C) instead of m g: the same rule with N0 = P_l.
-    assert observe(dataset(t, creeping, k_d=0.5 / 20.0, P_l=2.0), settings).regime == STUCK
+    assert regime(3.0, P_l=2.0).regime == STUCK
 
 
 def test_a_block_that_never_touches_the_plate_is_flying_whatever_its_phi():

@@ -289,6 +289,8 @@ def test_unknown_names_and_wrong_types_are_refused_before_running(fmus):
         run_libcosim(osc, start_values={"omega": 2.0}, outputs=["x"], **grid)
     with pytest.raises(SetupError, match=r"substeps \(Integer\) cannot take 2\.5 of type float"):
         run_libcosim(osc, start_values={"substeps": 2.5}, outputs=["x"], **grid)
+    with pytest.raises(SetupError, match=r"substeps = 'many' is not one of its named values \(it has none\)"):
+        run_libcosim(osc, start_values={"substeps": "many"}, outputs=["x"], **grid)
     with pytest.raises(SetupError, match=r"damped \(Boolean\) cannot take 1 of type int; give a bool"):
         run_libcosim(osc, start_values={"damped": 1}, outputs=["x"], **grid)
     with pytest.raises(SetupError, match=r"inputs: .*x has causality 'output'"):

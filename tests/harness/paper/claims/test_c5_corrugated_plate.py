@@ -72,3 +72,18 @@ def test_c5a_compares_the_cycle_with_a_0_and_says_why_when_a_0_has_none():
     short = verdict_c5(c5_measured({"slip_interval": None, "slope_angle_end": 81.0}, {}))[0]
     assert short.verdict == NOT_REPRODUCED and "fewer than two" in short.reason and "81" in short.reason
     assert "A = 0 (A w^2/g = 0): jammed" in jammed.measured
+
+
+def test_c5c_without_friction_runs_past_the_eq9_fold_and_a_rest_there_is_stuck_not_jammed():
+    """k_t = 0 cannot self-lock: the run lasts past the fold of Eq. (9), the stretch
+    A_x omega_x m g / k_d = 2000 at V_d = 1e-2 (t = 2e5), and a block still at rest is
+    reported as stuck with the run's length."""
+    from harness.paper.claims.c5_corrugated_plate import FOLD_MARGIN, frictionless_horizon, verdict_c5
+    from harness.paper.claims.verdicts import NOT_REPRODUCED
+
+    assert frictionless_horizon(1e5) == pytest.approx(FOLD_MARGIN * 2e5)
+    assert frictionless_horizon(1e6) == 1e6
+    measured = c5_measured({}, {})
+    measured["frictionless"].update(regime="stuck", slip_events=0, horizon=2.5e5)
+    row = verdict_c5(measured)[2]
+    assert row.verdict == NOT_REPRODUCED and "Eq. 9" in row.reason and "2.5e+05" in row.reason
