@@ -54,7 +54,8 @@ SPEED_SCENARIOS = [("A", "symplectic_euler", 800.0), ("B", "symplectic_euler", 8
                    ("A", "event_driven", 1e7), ("A", "adaptive", 1e7), ("B", "adaptive", 4000.0),
                    ("C", "adaptive", 5e4)]
 
-# Child: the kernels of one integrator record compiled in this process's (empty) cache.
+# Child: the kernels of one integrator record (or the chain's one kernel, both of its
+# schemes) compiled in this process's (empty) cache.
 COMPILE = r"""
 import json, os, sys, time
 wall, cpu = time.perf_counter(), time.process_time()
@@ -62,13 +63,22 @@ import numpy as np
 from vibroblock import layout as L
 from vibroblock.integrators import BY_ID
 from vibroblock.native import entry_address
-record = next(r for r in BY_ID.values() if r.name == sys.argv[1])
 times = {"import": [time.perf_counter() - wall, time.process_time() - cpu]}
-arrays = (0, 0, np.zeros(L.N_Y), np.zeros(L.N_CNT, np.int64), np.zeros(L.N_DRV), np.zeros(L.N_PRM))
-for name, compile_ in (("advance", lambda: record.bind_advance(*arrays)),
-                       ("observe", lambda: record.bind_observe(*arrays)),
-                       ("C advance", lambda: entry_address(record.advance, record.id)),
-                       ("C observe", lambda: entry_address(record.observe, record.id))):
+if sys.argv[1] == "chain":
+    from vibroblock.chain import Chain
+    def advance_chain():
+        chain = Chain(2, A=0.3, omega=0.5)
+        chain.start(0.0)
+        chain.advance_to(1.0)
+    steps = (("advance", advance_chain), ("observe", lambda: None), ("C advance", lambda: None),
+             ("C observe", lambda: None))
+else:
+    record = next(r for r in BY_ID.values() if r.name == sys.argv[1])
+    arrays = (0, 0, np.zeros(L.N_Y), np.zeros(L.N_CNT, np.int64), np.zeros(L.N_DRV), np.zeros(L.N_PRM))
+    steps = (("advance", lambda: record.bind_advance(*arrays)), ("observe", lambda: record.bind_observe(*arrays)),
+             ("C advance", lambda: entry_address(record.advance, record.id)),
+             ("C observe", lambda: entry_address(record.observe, record.id)))
+for name, compile_ in steps:
     wall, cpu = time.perf_counter(), time.process_time()
     compile_()
     times[name] = [time.perf_counter() - wall, time.process_time() - cpu]
@@ -155,8 +165,17 @@ def fmu_sizes(fmu_dir: Path) -> None:
 
     print("\n2. FMU sizes (target: each Block FMU <= 5 MB)")
     for fmu in sorted(fmu_dir.glob("*.fmu")):
-        shipped = ", ".join(kernels.shipped_jobs(fmu.stem[len("Block"):])) if fmu.stem.startswith("Block") else "-"
+        shipped = ", ".join(kernels.shipped_jobs(fmu.stem[len("Block"):])) if fmu in block_fmus(fmu_dir) else (
+            kernels.CHAIN_JOB if fmu.stem == "BlockChain" else "-")
         print(f"   {fmu.name:16} {fmu.stat().st_size / 1e6:6.2f} MB   kernels shipped: {shipped}")
+
+
+def block_fmus(fmu_dir: Path) -> list[Path]:
+    """The single-block FMUs, one per model variant (not BlockChain)."""
+    sys.path.insert(0, str(CORE.parent))
+    from vibroblock.models import VARIANTS
+
+    return [fmu_dir / f"Block{model}.fmu" for model in VARIANTS if (fmu_dir / f"Block{model}.fmu").is_file()]
 
 
 def first_step(fmu: Path, cache: Path, settings: dict, scratch: Path) -> dict:
@@ -206,7 +225,7 @@ def first_steps(fmu_dir: Path, scratch: Path) -> None:
                              cwd=floor_dir, capture_output=True, text=True, check=True)
         imported, called = json.loads(out.stdout.strip().splitlines()[-1])
         print(f"   numba's floor: import {imported:.2f} s, first call of a trivial kernel ({label}) {called:.2f} s")
-    for fmu in sorted(fmu_dir.glob("Block*.fmu")):
+    for fmu in block_fmus(fmu_dir):
         cache = scratch / f"cache-{fmu.stem}"
         print(_row(f"{fmu.stem} default, cold (empty cache)", first_step(fmu, cache, {}, scratch)))
         print(_row(f"{fmu.stem} default, warm (the cold run's cache)", first_step(fmu, cache, {}, scratch)))
@@ -297,7 +316,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="FMU sizes and first doSteps only; publishes nothing")
     parser.add_argument("--sections", default="1,2,3,4,5", help="the sections to measure, e.g. 5")
     args = parser.parse_args(argv)
-    if not list(args.fmu_dir.glob("Block*.fmu")):
+    if not block_fmus(args.fmu_dir):
         parser.error(f"no Block FMUs in {args.fmu_dir}: run make fmus first")
     scratch = Path(tempfile.mkdtemp(prefix="build_cost-"))
     try:
