@@ -11,7 +11,7 @@ import math
 from numba import njit
 
 from .friction_cundall_strack import energy, released, spring_force  # noqa: F401  (the same spring)
-from .rate_state import P_DC, PARAMETERS, REFUSED_BY, initial_state, interface_slip  # noqa: F401
+from .rate_state import P_DC, PARAMETERS, REFUSED_BY, initial_state, rule_with  # noqa: F401
 
 ID = 4
 
@@ -25,11 +25,4 @@ def evolve(theta, slip_rate, h, prm):
     return theta * math.exp(math.log(slip_rate * theta / prm[P_DC]) * math.expm1(-x))
 
 
-@njit(inline="always")
-def rule(shear, theta, penetration, bound_normal, slip_rate, h, prm):
-    """The interface's slip over the step, then theta's evolution at its rate.
-    Returns (F, theta, False): rate-and-state friction has no reset."""
-    shear, rate = interface_slip(shear, theta, penetration, bound_normal, h, prm)
-    if rate < 0.0:  # no contact: theta kept
-        return shear, theta, False
-    return shear, evolve(theta, rate, h, prm), False
+rule = rule_with(evolve)

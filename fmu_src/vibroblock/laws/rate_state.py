@@ -180,3 +180,17 @@ def interface_slip(shear, theta, penetration, bound_normal, h, prm):
 def relative_expm1(x):
     """-expm1(-x) / x, 1 at x = 0: the weight of a constant source over a decay."""
     return -math.expm1(-x) / x if x > 1e-300 else 1.0
+
+
+def rule_with(evolve):
+    """The friction rule (``laws``: friction) of a rate-and-state law whose theta evolves
+    over a step by the compiled ``evolve(theta, V, h, prm)``: the interface's slip over
+    the step, then theta's evolution at its rate.  The rule returns (F, theta, False):
+    rate-and-state friction has no reset."""
+    @njit(inline="always")
+    def rule(shear, theta, penetration, bound_normal, slip_rate, h, prm):
+        shear, rate = interface_slip(shear, theta, penetration, bound_normal, h, prm)
+        if rate < 0.0:  # no contact: theta kept
+            return shear, theta, False
+        return shear, evolve(theta, rate, h, prm), False
+    return rule
