@@ -298,6 +298,9 @@ class Chain:
             raise ModelError(f"not a valid chain state: {exc}") from None
         if n_blocks != self.n_blocks or arrays["Y"].shape != (n_blocks, L.N_Y):
             raise ModelError(f"not a valid chain state: it holds {n_blocks} blocks, this chain {self.n_blocks}")
+        if arrays["chn"].shape != (K.N_CHN,) or arrays["scratch"].shape != (n_blocks, K.N_SCRATCH):
+            raise ModelError("not a valid chain state: its arrays have another layout (saved by another version "
+                             "of the chain)")
         self.settings = Settings.from_dict(state["settings"], "A")
         self.chain_parameters = dict(state["chain_parameters"])
         self.periodic, self.energy_balance = bool(state["periodic"]), bool(state["energy_balance"])

@@ -185,3 +185,17 @@ def test_rk4_s_looser_step_bound_is_checked_with_the_coupling():
         Chain(4, integrator="symplectic_euler", k_c=1.0, dt=0.9).start()
     with pytest.raises(ModelError, match="> 4 .rk4."):
         Chain(4, integrator="rk4", k_c=1.0, dt=1.1).start()
+
+
+def test_a_state_of_another_layout_is_refused_and_the_run_goes_on():
+    """A state whose constants or scratch arrays have another length (saved by another
+    version of the chain) would be read past its end by the kernel: refused."""
+    chain = _chain(3)
+    chain.start()
+    chain.advance_to(10.0)
+    state = chain.get_state()
+    for name, cut in (("chn", lambda a: a[:-1]), ("scratch", lambda a: [row[:6] for row in a])):
+        with pytest.raises(ModelError, match="another layout"):
+            chain.set_state({**state, name: cut(state[name])})
+    chain.advance_to(20.0)
+    assert chain.time == 20.0
