@@ -81,36 +81,15 @@ def state_term(theta, prm):
 
 
 @njit
-def coefficient(slip_rate, theta, prm):
-    """mu(V, theta) = a asinh(V / (2 V_0) exp(Psi / a)), odd in V; computed in logarithms
-    where exp(Psi / a) would overflow."""
-    a, speed = prm[P_A], abs(slip_rate)
-    if speed == 0.0:
-        return 0.0
-    log_q = math.log(0.5 * speed / prm[P_V0]) + state_term(theta, prm) / a
-    mu = a * (log_q + LN2 + math.log1p(math.exp(-2.0 * log_q))) if log_q > 0.0 else a * math.asinh(math.exp(log_q))
-    return math.copysign(mu, slip_rate)
-
-
-@njit
-def log_slip_rate(r, theta, prm):
-    """ln V and d(ln V)/dr at r = k_t |F| / (a N_b) > 0, V = 2 V_0 exp(-Psi/a) sinh(r), in
-    logarithms (V overflows long before its logarithm does); below r = 1e-3 by the series
-    ln sinh r = ln r + r^2/6, coth r = 1/r + r/3 (exp(-2r) rounds to 1 near r = 0)."""
-    log_scale = math.log(prm[P_V0]) - state_term(theta, prm) / prm[P_A]
+def log_slip_rate(r, log_scale):
+    """ln V and d(ln V)/dr at r = k_t |F| / (a N_b) > 0, V = 2 V_0 exp(-Psi/a) sinh(r),
+    ``log_scale`` = ln V_0 - Psi/a; in logarithms (V overflows long before its logarithm
+    does); below r = 1e-3 by the series ln sinh r = ln r + r^2/6, coth r = 1/r + r/3
+    (exp(-2r) rounds to 1 near r = 0)."""
     if r < 1e-3:
         return log_scale + LN2 + math.log(r) + r * r / 6.0, 1.0 / r + r / 3.0
     tail = math.exp(-2.0 * r)
     return log_scale + r + math.log1p(-tail), (1.0 + tail) / (1.0 - tail)
-
-
-@njit
-def slip_rate_at(stress_ratio, theta, prm):
-    """The interface's slip rate V >= 0 under |k_t F| / N_b = ``stress_ratio`` >= 0."""
-    r = stress_ratio / prm[P_A]
-    if r <= 0.0:
-        return 0.0
-    return math.exp(log_slip_rate(r, theta, prm)[0])
 
 
 @njit
@@ -122,23 +101,25 @@ def relaxed(shear, theta, normal, h, prm):
     whose left side is near linear in r where V is large, by Newton's method kept inside
     the bracket (0, r_0) the two sides' monotony gives; where h V(r_0) is below rounding
     of |F_0| the spring keeps F_0."""
-    kt = prm[P_KT]
     target = abs(shear)
-    scale = kt / (prm[P_A] * normal)  # r per unit of |F|
+    scale = prm[P_KT] / (prm[P_A] * normal)  # r per unit of |F|
     r0 = scale * target
-    if r0 == 0.0 or h <= 0.0:
-        return target, slip_rate_at(r0 * prm[P_A], theta, prm)
+    if r0 == 0.0:
+        return target, 0.0
+    log_scale = math.log(prm[P_V0]) - state_term(theta, prm) / prm[P_A]  # ln V_0 - Psi/a: theta is held
+    log_v0 = log_slip_rate(r0, log_scale)[0]
+    if h <= 0.0:
+        return target, math.exp(log_v0)
     log_h = math.log(h * scale)  # h V in units of r
-    log_v0 = log_slip_rate(r0, theta, prm)[0]
     if log_h + log_v0 < math.log(2.2e-16 * r0):
         return target, math.exp(log_v0)
     low, high = 0.0, r0
     if log_h + log_v0 < math.log(0.5 * r0):  # first guess: one step of the small slip
         r = r0 - math.exp(log_h + log_v0)
     else:  # where ln V ~ ln V_0 - Psi/a + r meets ln(r_0 / h)
-        r = math.log(r0) - log_h - math.log(prm[P_V0]) + state_term(theta, prm) / prm[P_A]
+        r = math.log(r0) - log_h - log_scale
         if not 0.0 < r < r0:  # below r ~ 1 V is linear, 2 V_0 exp(-Psi/a) r
-            r = r0 / (1.0 + math.exp(log_h + math.log(2.0 * prm[P_V0]) - state_term(theta, prm) / prm[P_A]))
+            r = r0 / (1.0 + math.exp(log_h + LN2 + log_scale))
         if not 0.0 < r < r0:
             r = 0.5 * r0
     for _ in range(MAX_ITERATIONS):
@@ -147,7 +128,7 @@ def relaxed(shear, theta, normal, h, prm):
             high = r
             r = 0.5 * (low + high)
             continue
-        log_v, slope = log_slip_rate(r, theta, prm)
+        log_v, slope = log_slip_rate(r, log_scale)
         residual = log_h + log_v - math.log(gap)
         if residual > 0.0:
             high = r
@@ -163,7 +144,7 @@ def relaxed(shear, theta, normal, h, prm):
         if high - low <= 4e-16 * high:
             break
         r = r_next
-    return r / scale, math.exp(log_slip_rate(r, theta, prm)[0])
+    return r / scale, math.exp(log_slip_rate(r, log_scale)[0])
 
 
 @njit(inline="always")
