@@ -11,6 +11,7 @@ Prints, measured side by side in one run on one core:
 2. the shared fixed-step driver against a plain numba loop: model A's first-order
    scheme (``symplectic_euler``, vibrating) side by side with a hand-written numba
    kernel of the same scheme that calls sin/cos of the drive every step, and the ratio;
+   the previous release's driver (``--previous``) on the same run beside them;
 3. fmpy -> FMU cost: a fixed amount of work (internal steps) split into communication
    steps of 1, 10, 100 and 1000 internal steps, the overhead per doStep against the bare
    core doing the same work, and the FMU's slowdown relative to the core.
@@ -30,6 +31,8 @@ from fmpy.fmi2 import FMU2Slave
 
 from vibroblock import INTEGRATORS, Block, ModelError
 from vibroblock.models import VARIANTS
+
+from harness.benchmarks.build_cost import PREVIOUS, SpeedChild, previous_core
 
 ROOT = Path(__file__).resolve().parents[2]
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}
@@ -88,6 +91,17 @@ def plain_seconds(steps, amp, omega):
     return best_of(3, run)
 
 
+def previous_release_seconds(commit: str, steps: int, drive: dict) -> float:
+    """The previous release's shared driver on the same run (model A, symplectic_euler), in
+    its own process (``build_cost.SpeedChild``, the release as a git worktree), best of 3."""
+    child = SpeedChild(previous_core(commit), ROOT / "build" / "work" / f"numba-release-{commit}")
+    try:
+        return min(child.seconds(["A", "symplectic_euler", DT * (steps + 1), dict(SCALED, dt=DT, **drive)])[0]
+                   for _ in range(3))
+    finally:
+        child.close()
+
+
 def fmu_seconds(unzipdir, md, steps, substeps_per_step):
     slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
                       instanceName="bench")
@@ -97,6 +111,8 @@ def fmu_seconds(unzipdir, md, steps, substeps_per_step):
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
         slave.setReal([vr[k] for k in SCALED], list(SCALED.values()))
+        # The bare core's run: symplectic_euler (not the FMU's default integrator) from initial_state 2.
+        slave.setInteger([vr["integrator"], vr["initial_state"]], [INTEGRATORS["symplectic_euler"], 2])
         slave.exitInitializationMode()
         h = substeps_per_step * DT
         n_calls = steps // substeps_per_step
@@ -117,6 +133,8 @@ def main(argv=None):
     parser.add_argument("--fmu-dir", type=Path, default=ROOT / "build" / "fmus")
     parser.add_argument("--substeps", type=float, default=2e7, help="internal steps per core measurement")
     parser.add_argument("--fmu-work", type=float, default=2e5, help="internal steps per FMU measurement")
+    parser.add_argument("--previous", default=PREVIOUS,
+                        help="the release whose driver section 2 also times ('' to skip)")
     args = parser.parse_args(argv)
     steps = int(args.substeps)
 
@@ -136,6 +154,11 @@ def main(argv=None):
     plain = plain_seconds(steps, drive["A"], drive["omega"])
     print(f"\n2. model A, symplectic_euler, vibrating: shared driver {steps / ours / 1e6:.1f} Msteps/s, plain numba "
           f"loop with sin/cos per step {steps / plain / 1e6:.1f} Msteps/s: ratio {plain / ours:.2f}x (target >= 2)")
+    if args.previous:
+        before = previous_release_seconds(args.previous, steps, drive)
+        print(f"   the release {args.previous}'s driver on the same run (its own process, CPU time): "
+              f"{steps / before / 1e6:.1f} Msteps/s: ratio {plain / before:.2f}x; this driver / the release's "
+              f"speed {before / ours:.2f}")
 
     work = int(args.fmu_work)
     md = read_model_description(str(args.fmu_dir / "BlockA.fmu"))
