@@ -78,8 +78,7 @@ class Block:
             except ModelError:
                 self.parameters[name] = previous
                 raise
-            # new A, omega from the current grid step on, the phase continuous
-            run_arrays.retune_drive(self.cnt, self.drv, self.parameters["A"], self.parameters["omega"])
+            run_arrays.retune_drive(self.cnt, self.drv, self.parameters, self.readings)  # the phase continuous
             self._observed = None
             if self.settings.kernel(self.frozen_released) is not self._kernel:
                 self._bind_kernels()
@@ -124,11 +123,12 @@ class Block:
         self.y[L.Y_E_NORMAL] = contact_energy(self.settings, self.prm, obs[L.O_PENETRATION])  # the kernels' book of it
         self.y[L.Y_E_START] = stored_energy(self.settings, self.prm, obs, t0)
 
-    def set_plate_input(self, z: float, v: float, a: float) -> None:
-        """External plate motion from the current time on: z + v tau + a tau^2 / 2."""
-        run_arrays.check_plate_input(z, v, a)
+    def set_plate_input(self, z: float, v: float, a: float, *along_x: float) -> None:
+        """External plate motion from the current time on: z + v tau + a tau^2 / 2, and
+        ``along_x`` = (x, vx, ax): x + vx tau + ax tau^2 / 2 (plate_motion = 1 only)."""
+        run_arrays.check_plate_input((z, v, a, *along_x), self.readings)
         self._require_started()
-        run_arrays.set_plate_input(self.drv, self.time, z, v, a)
+        run_arrays.set_plate_input(self.drv, self.time, z, v, a, *along_x)
         self._observed = None
 
     def _bind_kernels(self) -> None:

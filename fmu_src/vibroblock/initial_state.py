@@ -20,9 +20,9 @@ def place(settings: Settings, prm, drv, y) -> bool:
     x = p["x_start"]
     height, slope = variant.profile(x, prm)
     cos_a, sin_a = 1.0 / math.sqrt(1.0 + slope * slope), slope / math.sqrt(1.0 + slope * slope)
-    phase = drv[L.D_PHASE]
-    plate_z = p["A"] * math.sin(phase) + height
-    plate_v = p["A"] * p["omega"] * math.cos(phase)
+    phase, amplitude = drv[L.D_PHASE], drv[L.D_AMP]  # (the drive's vertical amplitude: A under the vertical law)
+    plate_z = amplitude * math.sin(phase) + height
+    plate_v = amplitude * p["omega"] * math.cos(phase)
     # The confining load's component into the plate sets the rest penetration.
     load_x, load_z = variant.load(cos_a, sin_a, prm)
     weight = max(0.0, -(-load_x * sin_a + load_z * cos_a))
@@ -36,9 +36,23 @@ def place(settings: Settings, prm, drv, y) -> bool:
     elif settings.initial_state == 1:
         y[L.Y_Z], y[L.Y_VZ] = p["z_start"], p["vz_start"]
     else:
-        offset, rate = _steady_orbit(settings, weight, phase)
+        offset, rate = _steady_orbit(settings, weight, phase, amplitude)
         y[L.Y_Z], y[L.Y_VZ] = plate_z + offset, plate_v + rate
+    if drv[L.D_AMP_X] != 0.0:
+        _into_plate_frame(settings, drv, y)
     return _place_for_scene(settings, prm, drv, y)
+
+
+def _into_plate_frame(settings: Settings, drv, y) -> None:
+    """An oblique plate's run is integrated in the plate's frame (``laws.plate_oblique``):
+    x_start is where the block is in the lab, and its horizontal velocity is vx_start in
+    the lab if given (initial_state = 1), else relative to the plate (resting on it, or on
+    its steady orbit, moves with it)."""
+    phase, omega = drv[L.D_PHASE], settings.parameters["omega"]
+    plate_x, plate_vx = drv[L.D_AMP_X] * math.sin(phase), drv[L.D_AMP_X] * omega * math.cos(phase)
+    y[L.Y_X] -= plate_x
+    if settings.initial_state == 1:
+        y[L.Y_VX] -= plate_vx
 
 
 def _contact_at_rest(settings: Settings, weight: float) -> tuple[float, float, float]:
@@ -47,15 +61,16 @@ def _contact_at_rest(settings: Settings, weight: float) -> tuple[float, float, f
     return law("contact", settings.readings["contact_law"]).module.rest(weight, settings.parameters)
 
 
-def _steady_orbit(settings: Settings, weight, phase):
-    """``orbits.steady_orbit`` for the run's parameters, about the contact's rest
-    penetration; a nonlinear contact's orbit is its linearisation's there (a start close
-    to the orbit, whose transient the contact's damping removes).  A drive that has none
-    is refused."""
+def _steady_orbit(settings: Settings, weight, phase, amplitude=None):
+    """``orbits.steady_orbit`` for the run's parameters (the drive's vertical ``amplitude``,
+    A by default), about the contact's rest penetration; a nonlinear contact's orbit is its
+    linearisation's there (a start close to the orbit, whose transient the contact's
+    damping removes).  A drive that has none is refused."""
     p = settings.parameters
+    amplitude = p["A"] if amplitude is None else amplitude
     secant, stiffness, damping = _contact_at_rest(settings, weight)
     try:
-        oscillation, rate = steady_orbit(p["m"], stiffness, damping, 0.0, p["A"], p["omega"], phase)
+        oscillation, rate = steady_orbit(p["m"], stiffness, damping, 0.0, amplitude, p["omega"], phase)
     except ValueError as exc:
         raise ModelError(f"initial_state = 2 (steady_orbit): {exc}; start at rest or as given "
                          f"(initial_state = 0 or 1), or give the contact some damping") from None

@@ -9,12 +9,19 @@ from .readings import choices
 
 CHOICES = choices()  # the readings and the laws
 
-INPUTS = {
+VERTICAL_INPUTS = {
     "plate_z": ("delta_0", "external plate height, added to the internal drive"),
     "plate_v": ("delta_0/tau_0", "external plate velocity"),
     "plate_a": ("delta_0/tau_0^2", "external plate acceleration; over a communication step the plate follows "
                 "plate_z + plate_v tau + plate_a tau^2/2"),
 }
+HORIZONTAL_INPUTS = {
+    "plate_x": ("delta_0", "external horizontal plate position, along +x (plate_motion = 1 only; 0 otherwise)"),
+    "plate_vx": ("delta_0/tau_0", "external horizontal plate velocity (plate_motion = 1 only)"),
+    "plate_ax": ("delta_0/tau_0^2", "external horizontal plate acceleration (plate_motion = 1 only); over a "
+                 "communication step the plate follows plate_x + plate_vx tau + plate_ax tau^2/2"),
+}
+INPUTS = {**VERTICAL_INPUTS, **HORIZONTAL_INPUTS}  # the Block FMUs' (the chain has the vertical ones)
 OUTPUTS = {
     "x": ("Real", "delta_0", "horizontal block position"),
     "z": ("Real", "delta_0", "vertical block position"),

@@ -47,16 +47,22 @@ N_Y = 12
 C_STEP, C_SLIPS, C_PHASE_STEP, C_EVENTS, C_REJECTED, C_ACCEPTED, C_JACOBIANS, C_JUMPED = range(8)
 N_CNT = 8
 
-# Clock and plate drive, float64 array ``drv``: start time, step, harmonic amplitude,
-# angular frequency, drive phase at C_PHASE_STEP, and the external plate input
-# (height, velocity, acceleration) with the communication time at which it was set.
+# Clock and plate drive, float64 array ``drv``: start time, step, the harmonic drive's
+# vertical amplitude, angular frequency, drive phase at C_PHASE_STEP, and the external
+# plate input (height, velocity, acceleration) with the communication time at which it
+# was set; then the horizontal parts of an oblique plate (``laws.plate_oblique``): the
+# drive's horizontal amplitude and the external input's horizontal position, velocity
+# and acceleration (zero under the vertical plate law).
 D_T0, D_DT, D_AMP, D_OMEGA, D_PHASE, D_EXT_Z, D_EXT_V, D_EXT_A, D_EXT_T = range(9)
-N_DRV = 9
+D_AMP_X, D_EXT_X, D_EXT_VX, D_EXT_AX = range(9, 13)
+N_DRV = 13
 
 # One observation, float64 array ``obs`` that every integrator's observe kernel fills:
 # the state at the requested time, the contact quantities there, the quadratures, the
 # Coulomb resets so far, and the contact state and friction force as the scheme sees
-# them (a reduced scene has its own rigid contact and Coulomb force).
+# them (a reduced scene has its own rigid contact and Coulomb force); then the plate's
+# horizontal position and velocity, which O_X and O_VX include (the kernels integrate
+# an oblique plate's run in the plate's frame; 0 under the vertical plate law).
 (O_X, O_Z, O_VX, O_VZ, O_F, O_PENETRATION, O_NORMAL, O_COS, O_PHI, O_SLIPS, O_WORK, O_DISSIPATED,
- O_E_NORMAL, O_T, O_CONTACT, O_FRICTION) = range(16)
-N_OBS = 16
+ O_E_NORMAL, O_T, O_CONTACT, O_FRICTION, O_PLATE_X, O_PLATE_VX) = range(18)
+N_OBS = 18

@@ -42,9 +42,10 @@ def stored_energy(settings, prm, obs, t: float) -> float:
     """Kinetic + drive spring + friction spring + contact energy, each booked as its
     potential at the observed state (in the tangent frame the kinetic energy is
     m (u^2 + w^2) / 2, from the state's own slots): so the energy residual measures
-    the truth, also where a contact law is not conservative."""
+    the truth, also where a contact law is not conservative.  An oblique plate's balance
+    is kept in the plate's frame (``laws.plate_oblique``): x and vx relative to the plate."""
     p = settings.parameters
-    x, vx, vz, shear = obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F]
+    x, vx, vz, shear = obs[L.O_X] - obs[L.O_PLATE_X], obs[L.O_VX] - obs[L.O_PLATE_VX], obs[L.O_VZ], obs[L.O_F]
     stretch = x - p["V_d"] * t
     friction = float(law("friction", settings.readings.get("friction_law", 0)).module.energy.py_func(shear, prm))
     contact = contact_energy(settings, prm, obs[L.O_PENETRATION])
@@ -59,8 +60,8 @@ def observables(settings, prm, obs, stored_at_start: float) -> dict:
         residual = stored - stored_at_start - obs[L.O_WORK] + obs[L.O_DISSIPATED]
     pen, x, z, vx, vz = obs[L.O_PENETRATION], obs[L.O_X], obs[L.O_Z], obs[L.O_VX], obs[L.O_VZ]
     surface_z = z + pen / obs[L.O_COS]
-    if maps_to_point(settings):
-        surface_z, z, vx, vz = as_point(settings, prm, x, z, vx, vz, pen)
+    if maps_to_point(settings):  # (the surface at the plate's abscissa: an oblique plate carries it along x)
+        surface_z, z, vx, vz = as_point(settings, prm, x - obs[L.O_PLATE_X], z, vx, vz, pen)
     return {
         "x": float(x), "z": float(z), "vx": float(vx), "vz": float(vz),
         "friction_force": float(obs[L.O_FRICTION]),

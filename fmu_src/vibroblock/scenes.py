@@ -185,7 +185,7 @@ def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy
     """One reduced step (``scene_step``) under the driver's contract.  With FROZEN it
     returns STOP, the step not taken, where the frozen orbit would lose contact at the
     step's end: the caller hands over to the full model there."""
-    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate[:8]  # (a scene refuses the oblique plate: no frame force)
     t, h, span = clock
     x, z, vx, vz, shear = state
     rigid, frozen, coulomb = (flags & RIGID) != 0, (flags & FROZEN) != 0, (flags & COULOMB) != 0

@@ -183,11 +183,16 @@ class Settings:
     def check(self, frozen_released: bool = False) -> None:
         """Refuse settings that cannot run together (e.g. a dt the integrator cannot resolve)."""
         self._check_readings()
-        for axis in AXES.values():  # a law that states what its parameters must satisfy
-            check = getattr(LAWS[axis.name][self.readings.get(axis.parameter, 0)].module, "check", None)
+        for axis in AXES.values():  # a law that states what its parameters must satisfy, and where it cannot run
+            chosen = LAWS[axis.name][self.readings.get(axis.parameter, 0)]
+            check = getattr(chosen.module, "check", None)
             problem = check(self.parameters) if check else None
             if problem:
                 raise ModelError(problem)
+            for (reading, value), why in getattr(chosen.module, "REFUSED_READINGS", {}).items():
+                if self.readings.get(reading) == value:
+                    raise ModelError(f"{axis.parameter} = {chosen.id} ({chosen.name}) cannot run with {reading} = "
+                                     f"{value}: {why}")
         if self.scene_flags(frozen_released):
             self._check_scene_step()
             return

@@ -166,7 +166,7 @@ CASES = {
     "driven": ({"initial_state": 0}, (0.2, 1.3)),
     # Every axis' last law, chosen through the Integer parameters.
     "other_laws": ({"A": 0.5, "omega": 0.8, "integrator": 1, "contact_law": 3, "friction_law": 2, "mu_k": 0.3,
-                    "v_w": 0.5, "coulomb_normal": 2}, None),
+                    "v_w": 0.5, "coulomb_normal": 2, "plate_motion": 1, "drive_angle": 0.7}, None),
     # Rate-and-state friction: its state theta lives in the FMU between the host's steps.
     "rate_state": ({"A": 0.5, "omega": 0.8, "integrator": 1, "friction_law": 4, "rs_D_c": 0.1, "rs_V_0": 1e-3,
                     "rs_theta_0": 100.0}, None),

@@ -487,10 +487,11 @@ def test_two_instances_in_one_process_are_independent(extracted, fmu_log):
 
 
 # Every axis' last law at once: the Hertz-Hunt-Crossley contact, rate-and-state friction
-# with the slip law, and the load-only Coulomb bound.
+# with the slip law, the load-only Coulomb bound and the oblique plate.
 OTHER_LAWS = {"contact_law": 3, "friction_law": 4, "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0,
-              "coulomb_normal": 2}
-LAW_NAMES = {"contact_law": "hertz_hunt_crossley", "friction_law": "rate_state_slip", "coulomb_normal": "load_only"}
+              "coulomb_normal": 2, "plate_motion": 1, "drive_angle": 0.7}
+LAW_NAMES = {"contact_law": "hertz_hunt_crossley", "friction_law": "rate_state_slip", "coulomb_normal": "load_only",
+             "plate_motion": "oblique"}
 
 
 @pytest.mark.parametrize("laws", [{}, OTHER_LAWS], ids=["paper", "other_laws"])

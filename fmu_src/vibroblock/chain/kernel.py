@@ -147,7 +147,7 @@ def rk4_stage(kind, Y, PRM, chn, scratch, stage, clock, plate, track_energy):
             state = (scratch[i, S_STAGE_X], state[1] + offset * rates[1], state[2] + offset * rates[2],
                      state[3] + offset * rates[3], state[4] + offset * rates[4])
         new = stage_rates(kind, prm, state[0], state[1], state[2], state[3], state[4], t + offset, plate[0],
-                          plate[1], track_energy)
+                          plate[1], 0.0, track_energy)
         push = chn[H_KC] * pull_on(scratch[:, S_STAGE_X], i, periodic)
         weight = STAGE_WEIGHTS[stage]
         for k in range(N_RATES):

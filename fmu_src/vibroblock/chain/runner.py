@@ -177,7 +177,7 @@ class Chain:
         return np.zeros((rows, K.N_ROW))
 
     def set_plate_input(self, z: float, v: float, a: float) -> None:
-        run_arrays.check_plate_input(z, v, a)
+        run_arrays.check_plate_input((z, v, a))
         self._require_started()
         run_arrays.set_plate_input(self.drv, self.time, z, v, a)
 

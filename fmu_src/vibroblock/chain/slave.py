@@ -14,7 +14,7 @@ from pythonfmu.variables import Boolean, Integer, Real, String
 
 from .. import layout as L
 from ..fmi import FmuFacade, PlateInputs, fmu_class
-from ..interface import INPUTS, reading_choices
+from ..interface import VERTICAL_INPUTS as INPUTS, reading_choices
 from ..models import parameters_for
 from ..settings import ModelError
 from .runner import CHAIN_PARAMETERS, SCHEMES, Chain

@@ -35,12 +35,14 @@ from numba import literally, njit, types
 from numba.extending import overload
 
 from ..dynamics import contact, coulomb_bound, friction_rule
-from ..laws import friction_released, friction_spring_force
+from ..laws import friction_released, friction_spring_force, plate_moves_sideways
 from ..unowned import data_pointer
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
-                      O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_SLIPS, O_T, O_VX, O_VZ, O_WORK, O_X, O_Z,
+                      O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_PLATE_VX, O_PLATE_X, O_SLIPS, O_T, O_VX,
+                      O_VZ, O_WORK, O_X, O_Z,
                       Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
-from .plate import drive_sin_cos, next_sin_cos, phase_after, plate_after, plate_at, plate_moves
+from .plate import (drive_sin_cos, frame_force, next_sin_cos, phase_after, plate_after, plate_at, plate_moves,
+                    plate_sideways)
 
 OK, STOP = 0, 1
 NON_FINITE = -1
@@ -101,6 +103,7 @@ def record_observation(obs, state, contact_now, sums, t, friction):
     obs[O_WORK], obs[O_DISSIPATED], obs[O_E_NORMAL] = work, dissipated, e_normal
     obs[O_CONTACT] = 1.0 if in_contact else 0.0
     obs[O_FRICTION] = friction
+    obs[O_PLATE_X] = obs[O_PLATE_VX] = 0.0
     return N_OBS
 
 
@@ -159,20 +162,32 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     t = t0 + n * dt
     pz0, pv0 = plate_at(drv, s, c, t)
     contact0 = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    # An oblique plate's run is integrated in the plate's frame, moved by its force.
+    sideways = plate_moves_sideways(kind)
+    frame0 = frame_force(kind, drv, prm, s, c, t) if sideways else 0.0
+    frame_half = frame1 = 0.0
     status = OK
     done = 0
     while done < n_steps:
         n1 = n + 1
         t1 = t0 + n1 * dt
         if moving:
-            pzh, pvh = plate_at(drv, s * half_c + c * half_s, c * half_c - s * half_s, t + 0.5 * dt)
+            s_half, c_half = s * half_c + c * half_s, c * half_c - s * half_s
+            pzh, pvh = plate_at(drv, s_half, c_half, t + 0.5 * dt)
+            if sideways:
+                frame_half = frame_force(kind, drv, prm, s_half, c_half, t + 0.5 * dt)
             s, c = next_sin_cos(drv, cnt, n1, s, c, rot_s, rot_c)
             pz1, pv1 = plate_at(drv, s, c, t1)
         else:
             pzh, pvh, pz1, pv1 = pz0, pv0, pz0, pv0
+            if sideways:
+                frame_half = frame_force(kind, drv, prm, s, c, t + 0.5 * dt)
+        if sideways:
+            frame1 = frame_force(kind, drv, prm, s, c, t1)
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
          d_normal) = scheme_step(method, kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), contact0,
-                                 (t, dt, t1 - t), (pz0, pv0, pzh, pvh, pz1, pv1, s, c), track_energy)
+                                 (t, dt, t1 - t), (pz0, pv0, pzh, pvh, pz1, pv1, s, c, frame0, frame_half, frame1),
+                                 track_energy)
         if status != OK:
             if status < 0:
                 return status
@@ -182,7 +197,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
         shear, friction_state, slips, phi, phi_c, work, dissipated, e_normal = settle(
             kind, prm, (shear1, friction_state), (rule_pen, rule_normal, contact1[2], dt), slips,
             (phi, phi_c, work, dissipated, e_normal), (d_phi, d_work, d_dissipated, d_normal), track_energy)
-        n, t, pz0, pv0 = n1, t1, pz1, pv1
+        n, t, pz0, pv0, frame0 = n1, t1, pz1, pv1, frame1
         done += 1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return NON_FINITE
@@ -214,15 +229,20 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
     n = cnt[C_STEP]
     pz0, pv0 = plate_after(drv, cnt, n, 0.0)
     state_contact = contact(kind, x, z, vx, vz, pz0, pv0, prm)
+    sideways = plate_moves_sideways(kind)
     if h > 0.0:
         ctx = scheme_prepare(method, kind, flags, drv, prm, h)
         pzh, pvh = plate_after(drv, cnt, n, 0.5 * h)
         phase1 = phase_after(drv, cnt, n, h)
         s1, c1 = math.sin(phase1), math.cos(phase1)
         pz1, pv1 = plate_at(drv, s1, c1, t + h)
+        frame0 = frame_half = frame1 = 0.0
+        if sideways:
+            frame0, frame_half = frame_after(kind, drv, cnt, prm, n, 0.0), frame_after(kind, drv, cnt, prm, n, 0.5 * h)
+            frame1 = frame_force(kind, drv, prm, s1, c1, t + h)
         (status, x1, z1, vx1, vz1, shear1, contact1, rule_pen, rule_normal, d_phi, d_work, d_dissipated,
-         d_normal) = scheme_step(method, kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), state_contact,
-                                 (t, h, h), (pz0, pv0, pzh, pvh, pz1, pv1, s1, c1), track_energy)
+         d_normal) = scheme_step(method, kind, flags, ctx, prm, drv, (x, z, vx, vz, shear), state_contact, (t, h, h),
+                                 (pz0, pv0, pzh, pvh, pz1, pv1, s1, c1, frame0, frame_half, frame1), track_energy)
         if status == OK:
             x, z, vx, vz, shear = x1, z1, vx1, vz1, shear1
         else:
@@ -240,6 +260,19 @@ def observe(kind, method, flags, y, cnt, drv, prm, h, track_energy, obs):
                                                  (d_work, d_dissipated, d_normal), loaded, shear, track_energy)
         t += h
     pen, u_n, u_t, cos_a, sin_a, normal = state_contact
-    return record_observation(obs, (x, z, vx, vz, shear), (pen, normal, cos_a, pen > 0.0),
-                              (phi, slips, work, dissipated, e_normal),
-                              t, -friction_spring_force(kind, shear, prm) if pen > 0.0 else 0.0)
+    record_observation(obs, (x, z, vx, vz, shear), (pen, normal, cos_a, pen > 0.0),
+                       (phi, slips, work, dissipated, e_normal),
+                       t, -friction_spring_force(kind, shear, prm) if pen > 0.0 else 0.0)
+    if sideways:  # the lab's x and vx: the plate frame's plus the plate's
+        phase = phase_after(drv, cnt, n, h)
+        plate_x, plate_vx, _ = plate_sideways(kind, drv, math.sin(phase), math.cos(phase), t)
+        obs[O_X], obs[O_VX] = x + plate_x, vx + plate_vx
+        obs[O_PLATE_X], obs[O_PLATE_VX] = plate_x, plate_vx
+    return N_OBS
+
+
+@njit(inline="always")
+def frame_after(kind, drv, cnt, prm, n, h):
+    """The plate frame's force a time h after grid step n (off the grid): exact sin/cos."""
+    phase = phase_after(drv, cnt, n, h)
+    return frame_force(kind, drv, prm, math.sin(phase), math.cos(phase), drv[D_T0] + n * drv[D_DT] + h)

@@ -296,9 +296,10 @@ def contact_release(a, w2, b, d0, v0, span):
 
 # ---------------------------------------------------------------------- one step
 @njit(inline="always")
-def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel):
+def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel, push):
     """The soft forces at the midpoint, in the frame there (step 2 of the module doc), from
-    ``start`` = (delta, u_n, u_t, cos, sin) at the step's start.  Returns (status, (cos,
+    ``start`` = (delta, u_n, u_t, cos, sin) at the step's start; ``push`` is the plate
+    frame's horizontal force at the mid time (``laws.plate_oblique``).  Returns (status, (cos,
     sin, turning rate Omega, slope at x + h vx), (normal force, tangential force, the
     drive's pull at the start position less at the midpoint, load_x, load_z))."""
     m = prm[P_M]
@@ -315,6 +316,9 @@ def _soft_forces(kind, prm, x, vx, t, h, start, plate_accel):
             return TOO_FAST_FOR_CORRUGATION, (cos_m, sin_m, turn_rate, slope_end), (0.0, 0.0, 0.0, 0.0, 0.0)
     drive = -prm[P_KD] * (x_mid - prm[P_VD] * t_mid)
     drive_start = -prm[P_KD] * (x - prm[P_VD] * t_mid)
+    if push != 0.0:  # (a vertical plate adds nothing, not even the sign of a zero)
+        drive += push
+        drive_start += push
     load_x, load_z = load(kind, cos_m, sin_m, prm)
     force_n = -(drive + load_x) * sin_m + load_z * cos_m - m * plate_accel * cos_m
     force_t = (drive + load_x) * cos_m + load_z * sin_m - m * plate_accel * sin_m
@@ -503,7 +507,8 @@ def _tangential_flow(kind, prm, table, h, start, forces, segments, track_energy,
 @njit(cache=True)
 def implicit_contact_step(kind, prm, state, t, h, plate, ctx, track_energy):
     """One step of length h from ``state`` = (x, z, vx, vz, F) at time t; ``plate`` =
-    (height, velocity) at t and at t + h.  ``ctx`` holds ``step_propagators(prm, h)`` and
+    (height, velocity) at t and at t + h, and the plate frame's horizontal force at
+    t + h/2.  ``ctx`` holds ``step_propagators(prm, h)`` and
     the scratch arrays of MAX_SEGMENTS entries for the segments' lengths and contact states.
 
     Returns (status, x, z, vx, vz, F, d_phi, d_work, d_dissipated): status 0, or
@@ -511,12 +516,12 @@ def implicit_contact_step(kind, prm, state, t, h, plate, ctx, track_energy):
     The friction rule at the new state is the caller's (as for every integrator).
     """
     x, z, vx, vz, shear = state
-    pz0, pv0, pz1, pv1 = plate
+    pz0, pv0, pz1, pv1, push = plate
     table, seg_len, seg_contact = ctx
     pen0, u_n0, u_t0, cos0, sin0, _ = contact(kind, x, z, vx, vz, pz0, pv0, prm)
     start = (pen0, u_n0, u_t0, cos0, sin0)
     plate_accel = (pv1 - pv0) / h
-    status, frame_m, forces = _soft_forces(kind, prm, x, vx, t, h, start, plate_accel)
+    status, frame_m, forces = _soft_forces(kind, prm, x, vx, t, h, start, plate_accel, push)
     if status != 0:
         return status, x, z, vx, vz, shear, 0.0, 0.0, 0.0
     cos_m, sin_m, turn_rate, slope_end = frame_m
@@ -565,6 +570,8 @@ def implicit_contact_step(kind, prm, state, t, h, plate, ctx, track_energy):
     if track_energy:
         work += prm[P_KD] * (vd * (t + 0.5 * h) - 0.5 * (x + x1)) * vd * h  # the drive's far end
         work += load_x * (x1 - x) + load_z * (z1 - z)  # the load, constant over the step
+        if push != 0.0:
+            work += push * (x1 - x)  # the plate frame's force, at its mid-step value
     return 0, x1, z1, vx1, vz1, f, d_phi, work, dissipated
 
 
@@ -579,10 +586,10 @@ def prepare(kind, flags, drv, prm, h):
 def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
     # The step is h exactly (the propagator table's); the grid times' difference would
     # carry the rounding of large t.
-    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1, frame0, frame_half, frame1 = plate
     t, h, span = clock
     status, x, z, vx, vz, shear, d_phi, d_work, d_dissipated = implicit_contact_step(
-        kind, prm, state, t, h, (pz0, pv0, pz1, pv1), ctx, track_energy)
+        kind, prm, state, t, h, (pz0, pv0, pz1, pv1, frame_half), ctx, track_energy)
     contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
     # (the normal spring's energy is booked as its potential at observation time: no increment)
     return (status, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, 0.0)

@@ -23,7 +23,9 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
 from ..dynamics import plate_motion
-from ..layout import C_PHASE_STEP, D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_PHASE, D_T0
+from ..laws import plate_horizontal
+from ..layout import (C_PHASE_STEP, D_AMP, D_AMP_X, D_DT, D_EXT_A, D_EXT_AX, D_EXT_T, D_EXT_V, D_EXT_VX, D_EXT_X,
+                      D_EXT_Z, D_OMEGA, D_PHASE, D_T0, P_KD, P_M)
 
 RESYNC = 256
 TWO_PI = 2.0 * math.pi
@@ -115,7 +117,24 @@ def plate_at(drv, s, c, t):
 def plate_moves(drv):
     """False for a plate at rest (no drive, no input): the loops then skip its kinematics,
     which gives the same bits (the plate formula returns the same height and 0 velocity)."""
-    return drv[D_AMP] != 0.0 or drv[D_EXT_V] != 0.0 or drv[D_EXT_A] != 0.0
+    return drv[D_AMP] != 0.0 or drv[D_EXT_V] != 0.0 or drv[D_EXT_A] != 0.0 or drv[D_AMP_X] != 0.0
+
+
+@njit(inline="always")
+def plate_sideways(kind, drv, s, c, t):
+    """The plate's horizontal position, velocity and acceleration at time t (the drive's
+    phase having sine s, cosine c); zero under the vertical plate law."""
+    return plate_horizontal(kind, drv[D_AMP_X], drv[D_OMEGA], s, c, drv[D_EXT_X], drv[D_EXT_VX], drv[D_EXT_AX],
+                            t - drv[D_EXT_T])
+
+
+@njit(inline="always")
+def frame_force(kind, drv, prm, s, c, t):
+    """The horizontal force on the block in the plate's frame (``laws.plate_oblique``): the
+    frame's inertial force -m p_x'' and the drive spring's -k_d p_x (its far end is fixed
+    in the lab, so in the plate's frame it sits at -p_x)."""
+    position, _, acceleration = plate_sideways(kind, drv, s, c, t)
+    return -prm[P_M] * acceleration - prm[P_KD] * position
 
 
 @njit(inline="always")

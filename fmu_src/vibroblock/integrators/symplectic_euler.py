@@ -53,8 +53,10 @@ def euler_step(kind, prm, state, t, h, contact_now, plate, track_energy, push):
 
 @njit(inline="always")
 def step(kind, flags, ctx, prm, drv, state, contact0, clock, plate, track_energy):
-    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1 = plate
+    pz0, pv0, pzh, pvh, pz1, pv1, s1, c1, frame0, frame_half, frame1 = plate
     t, h, span = clock
     x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
-        kind, prm, state, t, h, contact0, (pv0, pz1, pv1), track_energy, 0.0)
+        kind, prm, state, t, h, contact0, (pv0, pz1, pv1), track_energy, frame0)
+    if track_energy and frame0 != 0.0:  # the plate frame's force works on the block (laws.plate_oblique)
+        d_work += h * frame0 * state[2]
     return (0, x, z, vx, vz, shear, contact1, contact1[0], contact1[5], d_phi, d_work, d_dissipated, d_normal)

@@ -6,6 +6,7 @@ A law is one module ``<axis prefix><name>.py`` in this package stating:
 * ``ID``: its value of the axis' Integer parameter (stable, never reused; 0 is the default);
 * its compiled functions, the same for every law of an axis (below);
 * optionally ``REFUSED_BY``: {integrator name: why it cannot run this law};
+* optionally ``REFUSED_READINGS``: {(reading, value): why this law cannot run in it};
 * optionally ``PARAMETERS``: its own parameters (``parameters.Parameter``, read in the
   kernels at ``layout.slot(name)``), offered by every variant, and ``check(parameters)``:
   why the parameters cannot run the law, or None.
@@ -28,8 +29,11 @@ friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F
                                 slip rate there; in Python: initial_state(parameters),
                                 the state at the start (absent: 0)
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N
-plate         (one law)         motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau),
-                                acceleration(A, omega, sin, ext_a)
+plate         ``plate_motion``  motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau),
+                                acceleration(A, omega, sin, ext_a) (the vertical motion,
+                                the same for every law: D_AMP holds its amplitude);
+                                horizontal(A_x, omega, sin, cos, ext_x, ext_vx, ext_ax, tau)
+                                -> (x, v, a); in Python: amplitudes(A, angle) -> (A_z, A_x)
 ============  ================  ===============================================================
 
 A run's laws are part of the kernels' ``kind`` (``vibroblock.readings``: a few bits per
@@ -67,7 +71,7 @@ AXES = {
     "contact": Axis("contact", "contact_law", "contact_", 6, 2),
     "friction": Axis("friction", "friction_law", "friction_", 8, 3),
     "bound": Axis("bound", "coulomb_normal", "bound_", 11, 2),
-    "plate": Axis("plate", "plate_motion", "plate_", 13, 0),
+    "plate": Axis("plate", "plate_motion", "plate_", 13, 1),
 }
 
 
@@ -177,3 +181,6 @@ friction_released = _dispatch("friction", "released", "before, after, prm")
 friction_rule = _dispatch("friction", "rule", "shear, state, penetration, bound_normal, slip_rate, h, prm")
 bound_normal = _dispatch("bound", "normal", "kind, contact_normal, x, t, prm")
 plate_motion = _dispatch("plate", "motion", "amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau")
+plate_horizontal = _dispatch("plate", "horizontal",
+                             "amp_x, omega, sin_phase, cos_phase, ext_x, ext_vx, ext_ax, tau")
+plate_moves_sideways = _constant("plate", "SIDEWAYS")

@@ -7,6 +7,12 @@ parabola whose velocity is continuous where the master's samples are consistent.
 from numba import njit
 
 ID = 0
+SIDEWAYS = False  # no horizontal motion: the kernels skip the plate frame's force
+
+
+def amplitudes(amplitude: float, angle: float) -> tuple[float, float]:
+    """The drive's vertical and horizontal amplitudes (``layout.D_AMP``, ``D_AMP_X``)."""
+    return amplitude, 0.0
 
 
 @njit(inline="always")
@@ -21,3 +27,9 @@ def motion(amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau):
 def acceleration(amp, omega, sin_phase, ext_a):
     """Plate acceleration (the external input's held over the step)."""
     return -amp * omega * omega * sin_phase + ext_a
+
+
+@njit(inline="always")
+def horizontal(amp_x, omega, sin_phase, cos_phase, ext_x, ext_vx, ext_ax, tau):
+    """The plate's horizontal position, velocity and acceleration: none."""
+    return 0.0, 0.0, 0.0
