@@ -1,8 +1,10 @@
-"""FMU: a vertical plate motion (harmonic, chirps, sum of harmonics, record playback)
-with consistent outputs plate_z, plate_v = d(plate_z)/dt, plate_a = d(plate_v)/dt, to
+"""FMU: a plate motion (harmonic, chirps, sum of harmonics, record playback) with
+consistent outputs plate_z, plate_v = d(plate_z)/dt, plate_a = d(plate_v)/dt and, for a
+motion along ``direction`` or a three-component record, plate_x, plate_vx, plate_ax, to
 connect to the plate inputs of the Block FMUs.  Signals: vibroblock/excitation.py; the
 FMI machinery (errors, time, FMU state) is shared with the Block FMUs: vibroblock/fmi.py.
 """
+import math
 from pathlib import Path
 
 from pythonfmu import Fmi2Slave
@@ -17,7 +19,17 @@ OUTPUTS = {
     "plate_z": "plate height [delta_0]",
     "plate_v": "plate velocity, the exact derivative of plate_z [delta_0/tau_0]",
     "plate_a": "plate acceleration, the exact derivative of plate_v [delta_0/tau_0^2]",
+    "plate_x": "plate position along +x: sin(direction) times the signal, or a record's horizontal component "
+               "(record_components = 2) [delta_0]",
+    "plate_vx": "plate velocity along +x, the exact derivative of plate_x [delta_0/tau_0]",
+    "plate_ax": "plate acceleration along +x, the exact derivative of plate_vx [delta_0/tau_0^2]",
 }
+COMPONENTS_TEXT = ("components of a seismic record_file played in mode 4: 1 = one channel (the vertical one of "
+                   "several) as plate_z; 2 = a three-component record (channels Z, N, E, or Z, 1, 2 with "
+                   "record_inventory): its vertical motion as plate_z and its horizontal motion along "
+                   "record_azimuth as plate_x, each channel processed alike")
+AZIMUTH_TEXT = ("slip direction (+x) of a three-component record (record_components = 2): degrees clockwise from "
+                "north; plate_x = N cos(azimuth) + E sin(azimuth)")
 MODE_TEXT = ("signal f of signal time s = (t - onset)/time_scale; plate_z = amplitude_scale * w * f with w the "
              "start ramp (1 if ramp_time = 0). 0 = harmonic: amplitude sin(omega s + phase); 1 = linear chirp: "
              "amplitude sin(theta + phase), frequency linear from omega_start to omega_end over sweep_time; "
@@ -47,12 +59,13 @@ class ExcitationFacade(FmuFacade):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.description = ("Vertical plate motion with kinematically consistent height, velocity and "
-                            "acceleration, for the plate inputs of the vibroblock Block FMUs.")
+        self.description = ("Plate motion with kinematically consistent position, velocity and acceleration, "
+                            "vertical and along x, for the plate inputs of the vibroblock Block FMUs.")
         self.bundled = self._bundled_record(kwargs.get("resources"))
         self.plate = Plate(bundled=self.bundled)
         self.seismic_record = ""  # a record_file processed at initialization (see _start)
         self.record_inventory = ""
+        self.record_components, self.record_azimuth = 1, 0.0
         self._cache = None  # (time, outputs): the three getters of one step share one evaluation
         self._register_interface()
 
@@ -85,6 +98,14 @@ class ExcitationFacade(FmuFacade):
             "record_file", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=RECORD_TEXT, getter=lambda: self.seismic_record or self.plate.record_file,
             setter=lambda value: self._guard(self._set_record_file, value)))
+        self.register_variable(Integer(
+            "record_components", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description=COMPONENTS_TEXT, getter=lambda: self.record_components,
+            setter=lambda value: self._guard(self._set_components, int(value))))
+        self.register_variable(Real(
+            "record_azimuth", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description=f"{AZIMUTH_TEXT} [deg]", getter=lambda: self.record_azimuth,
+            setter=lambda value: self._guard(self._set_azimuth, float(value))))
         for name, text in OUTPUTS.items():
             self.register_variable(Real(
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
@@ -97,13 +118,30 @@ class ExcitationFacade(FmuFacade):
         if self._cache is None or self._cache[0] != time:
             try:
                 z, v, a = self.plate.evaluate(time)
-                values = {"plate_z": z, "plate_v": v, "plate_a": a}
+                x, vx, ax = self.plate.evaluate_horizontal(time)
+                values = {"plate_z": z, "plate_v": v, "plate_a": a, "plate_x": x, "plate_vx": vx, "plate_ax": ax}
             except Exception as exc:  # settings that do not fit together yet; start() will say why
                 if self.plate.started:
                     self.log(f"internal error while evaluating the plate motion: {exc!r}", Fmi2Status.error)
                 return 0.0
             self._cache = (time, values)
         return self._cache[1][name]
+
+    def _set_components(self, components: int) -> None:
+        if self.plate.started:
+            raise ExcitationError("record_components is fixed once the run has started")
+        if components not in (1, 2):
+            raise ExcitationError(f"record_components = {components!r} is not 1 (one channel) or 2 (vertical and "
+                                  "horizontal of a three-component record)")
+        self.record_components = components
+
+    def _set_azimuth(self, azimuth: float) -> None:
+        if self.plate.started:
+            raise ExcitationError("record_azimuth is fixed once the run has started")
+        if not math.isfinite(azimuth):
+            raise ExcitationError(f"record_azimuth = {azimuth!r} must be a finite number of degrees clockwise "
+                                  "from north")
+        self.record_azimuth = azimuth
 
     def _set_inventory(self, path: str) -> None:
         if self.plate.started:
@@ -129,23 +167,29 @@ class ExcitationFacade(FmuFacade):
                                   f"({Path.cwd()}), or leave it empty for the bundled record")
         self.seismic_record = str(path)
 
-    def _seismic_playback(self, path: str | None = None, inventory: str | None = None) -> Playback:
+    def _seismic_playback(self, path: str | None = None, inventory: str | None = None,
+                          components: int | None = None, azimuth: float | None = None) -> tuple:
         """The seismic record_file (or ``path``, with ``inventory``) processed to SI
-        (harness.ground.records, bundled)."""
+        (harness.ground.records, bundled): (vertical playback, horizontal playback or None)."""
         path = self.seismic_record if path is None else path
         inventory = self.record_inventory if inventory is None else inventory
+        components = self.record_components if components is None else components
+        azimuth = self.record_azimuth if azimuth is None else azimuth
         try:
-            from vibroblock_records import RecordError, load_ground_motion
+            from vibroblock_records import RecordError, load_ground_motion, load_ground_motion_components
         except ImportError:  # a process that has the harness: the same package
             try:
-                from harness.ground.records import RecordError, load_ground_motion
+                from harness.ground.records import RecordError, load_ground_motion, load_ground_motion_components
             except ImportError as exc:
                 raise ExcitationError(f"record_file = {path!r} is a seismic record, which needs obspy "
                                       f"in the FMU's Python environment ({exc}); install it (pip install obspy) or "
                                       "convert the record with 'vibroblock record FILE --save-record record.npz'") \
                     from None
         try:
-            motion = load_ground_motion(path, inventory=inventory or None)
+            if components == 2:
+                motion, horizontal = load_ground_motion_components(path, azimuth, inventory=inventory or None)
+            else:
+                motion, horizontal = load_ground_motion(path, inventory=inventory or None), None
         except RecordError as exc:
             if "no instrument response" in str(exc):
                 raise ExcitationError(
@@ -154,7 +198,10 @@ class ExcitationFacade(FmuFacade):
                     "convert it with 'vibroblock record FILE --sensitivity COUNTS_PER_UNIT --quantity Q --unit U "
                     "--save-record record.npz' and play that") from None
             raise ExcitationError(f"record_file = {path!r}: {exc}") from None
-        return Playback(motion.acceleration, motion.dt, motion.velocity[0], motion.displacement[0], source=path)
+        played = [None if m is None else Playback(m.acceleration, m.dt, m.velocity[0], m.displacement[0],
+                                                  source=f"{path} ({m.trace_id})" if horizontal else path)
+                  for m in (motion, horizontal)]
+        return played[0], played[1]
 
     # ------------------------------------------------------------------ facade hooks
     def _changed(self) -> None:
@@ -167,8 +214,12 @@ class ExcitationFacade(FmuFacade):
         return self.plate.time
 
     def _start(self, start_time: float) -> None:
+        if self.record_components == 2 and not (self.seismic_record and self.plate.mode == PLAYBACK):
+            raise ExcitationError("record_components = 2 plays a three-component seismic record_file in mode 4 "
+                                  "(playback); set mode = 4 and record_file, or record_components = 1")
         if self.seismic_record and self.plate.mode == PLAYBACK:
-            self.plate.use_record(self._seismic_playback(), name=self.seismic_record)
+            vertical, horizontal = self._seismic_playback()
+            self.plate.use_record(vertical, name=self.seismic_record, horizontal=horizontal)
         self.plate.start(start_time)
         if self.plate.mode == PLAYBACK:
             problems = self.plate.playback().rest_problems()
@@ -183,21 +234,25 @@ class ExcitationFacade(FmuFacade):
     # pythonfmu's default would capture the registered scalars only, not the clock.
     def _capture(self) -> dict:
         return {"plate": self.plate.get_state(), "start_time": self.start_time,
-                "seismic_record": self.seismic_record, "record_inventory": self.record_inventory}
+                "seismic_record": self.seismic_record, "record_inventory": self.record_inventory,
+                "record_components": self.record_components, "record_azimuth": self.record_azimuth}
 
     def _restore(self, state: dict) -> None:
-        known = self.plate.record
+        known, known_horizontal = self.plate.record, self.plate.horizontal_record
         seismic, inventory = str(state.get("seismic_record", "")), str(state.get("record_inventory", ""))
-        if seismic and state["plate"]["record_digest"] != getattr(known, "digest", None):
+        components, azimuth = int(state.get("record_components", 1)), float(state.get("record_azimuth", 0.0))
+        digests = (state["plate"]["record_digest"], state["plate"].get("horizontal_digest"))
+        if seismic and digests != (getattr(known, "digest", None), getattr(known_horizontal, "digest", None)):
             # A seismic record is known by its processed samples: process it again (a fresh
             # instance has not read it yet) and check that it is the same.
-            known = self._seismic_playback(seismic, inventory)
-            if known.digest != state["plate"]["record_digest"]:
+            known, known_horizontal = self._seismic_playback(seismic, inventory, components, azimuth)
+            if (known.digest, getattr(known_horizontal, "digest", None)) != digests:
                 raise ExcitationError(f"the record file {seismic!r} (or its inventory) changed since the state was "
                                       "saved")
-        plate = Plate.from_state(state["plate"], known=known, bundled=self.bundled)
+        plate = Plate.from_state(state["plate"], known=known, bundled=self.bundled, known_horizontal=known_horizontal)
         self.start_time = float(state["start_time"])
         self.seismic_record, self.record_inventory = seismic, inventory
+        self.record_components, self.record_azimuth = components, azimuth
         self.plate = plate
 
 

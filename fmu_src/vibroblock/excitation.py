@@ -122,6 +122,10 @@ PARAMETERS: tuple[Parameter, ...] = (
     Parameter("ramp_time", 0.0, "tau_0",
               "0: no envelope; > 0: plate at rest before onset, amplitude rising smoothly over ramp_time",
               NON_NEGATIVE),
+    Parameter("direction", 0.0, "rad",
+              "direction of the motion from the vertical towards +x: plate_z is cos(direction) and plate_x "
+              "sin(direction) times the signal (a Block with plate_motion = 1 takes plate_x; a record played "
+              "with its horizontal component has its own plate_x and ignores this)"),
 )
 PARAMETER_NAMES = tuple(p.name for p in PARAMETERS)
 _SPECS = {p.name: p for p in PARAMETERS}
@@ -374,6 +378,7 @@ class Excitation:
         self.mode = HARMONIC
         self.record_file = ""
         self.record: Playback | None = None
+        self.horizontal_record: Playback | None = None  # a record's own horizontal component (plate_x)
         self.started = False
         self.time = 0.0
         self.set_mode(mode)
@@ -412,13 +417,18 @@ class Excitation:
         record = load_record(path, self.bundled) if path else None
         self.record_file, self.record = path, record
 
-    def use_record(self, record: Playback, name: str = "") -> None:
+    def use_record(self, record: Playback, name: str = "", horizontal: Playback | None = None) -> None:
         """Play a record held in memory (e.g. a processed ground motion); ``name`` is
-        what ``record_file`` reports, for the log and the state."""
-        if not isinstance(record, Playback):
-            raise ExcitationError(f"use_record needs a Playback, not {type(record).__name__}")
+        what ``record_file`` reports, for the log and the state.  ``horizontal``: the
+        record's horizontal component along +x (e.g. a three-component record's, rotated
+        to the slip azimuth), played as plate_x on the same clock."""
+        for part in (record, horizontal):
+            if part is not None and not isinstance(part, Playback):
+                raise ExcitationError(f"use_record needs a Playback, not {type(part).__name__}")
+        if record is None:
+            raise ExcitationError("use_record needs a Playback, not None")
         self._require_not_started("the record")
-        self.record_file, self.record = name, record
+        self.record_file, self.record, self.horizontal_record = name, record, horizontal
 
     def playback(self) -> Playback:
         """The record of mode 4 (the bundled one unless record_file names another)."""
@@ -461,7 +471,25 @@ class Excitation:
 
     def evaluate(self, t):
         """(z, v, a) of the plate at time(s) t: floats for a float, arrays for an array."""
-        signal = self._signal if self.started else self.signal()
+        along = math.cos(self.parameters["direction"])
+        if self.horizontal_record is not None and self.mode == PLAYBACK:
+            along = 1.0  # the record's vertical channel: its horizontal one is plate_x
+        z, v, a = self._played(self._signal if self.started else self.signal(), t)
+        if along == 1.0:  # (the vertical motion itself, to the bit)
+            return z, v, a
+        return along * z, along * v, along * a
+
+    def evaluate_horizontal(self, t):
+        """(x, vx, ax) of the plate along +x at time(s) t: the record's horizontal
+        component, or sin(direction) times the signal."""
+        if self.horizontal_record is not None and self.mode == PLAYBACK:
+            return self._played(self.horizontal_record, t)
+        across = math.sin(self.parameters["direction"])
+        x, vx, ax = self._played(self._signal if self.started else self.signal(), t)
+        return across * x, across * vx, across * ax
+
+    def _played(self, signal, t):
+        """(f, f', f'') of ``signal`` played at time(s) t: scaled, stretched and ramped."""
         p = self.parameters
         t_arr = np.asarray(t, dtype=float)
         scale, stretch = p["amplitude_scale"], p["time_scale"]
@@ -480,7 +508,8 @@ class Excitation:
 
     def outputs(self) -> dict[str, float]:
         z, v, a = self.evaluate(self.time)
-        return {"plate_z": z, "plate_v": v, "plate_a": a}
+        x, vx, ax = self.evaluate_horizontal(self.time)
+        return {"plate_z": z, "plate_v": v, "plate_a": a, "plate_x": x, "plate_vx": vx, "plate_ax": ax}
 
     # ------------------------------------------------------------------ state
     def get_state(self) -> dict:
@@ -490,13 +519,20 @@ class Excitation:
         small, and a restore refuses a file whose contents changed meanwhile."""
         return {"mode": self.mode, "parameters": dict(self.parameters), "record_file": self.record_file,
                 "record_digest": self.record.digest if self.record is not None else None,
+                "horizontal_digest": self.horizontal_record.digest if self.horizontal_record is not None else None,
                 "started": self.started, "time": self.time}
 
     @classmethod
     def from_state(cls, state: dict, known: Playback | None = None,
-                   bundled: str | Path = BUNDLED_RECORD) -> "Excitation":
-        """A new excitation in ``state``; ``known`` is a record already read (reused if it is the same)."""
+                   bundled: str | Path = BUNDLED_RECORD, known_horizontal: Playback | None = None) -> "Excitation":
+        """A new excitation in ``state``; ``known`` is a record already read (reused if it is
+        the same), ``known_horizontal`` its horizontal component (which a state that has one
+        needs: it is read from a seismic record, not a file of its own)."""
         try:
+            horizontal_digest = state.get("horizontal_digest")
+            if horizontal_digest is not None and getattr(known_horizontal, "digest", None) != horizontal_digest:
+                raise ExcitationError("the state plays a record's horizontal component, which is not the one given "
+                                      "(the record file or its inventory changed since the state was saved)")
             excitation = cls(bundled=bundled)
             excitation.set_mode(int(state["mode"]))
             for name, value in state["parameters"].items():
@@ -509,6 +545,8 @@ class Excitation:
                 if excitation.record.digest != digest:
                     raise ExcitationError(f"the record file {record_file or str(bundled)!r} changed since "
                                           "the state was saved")
+            if horizontal_digest is not None:
+                excitation.horizontal_record = known_horizontal
             if state["started"]:
                 excitation.start(float(state["time"]))
             return excitation

@@ -39,11 +39,12 @@ import numpy as np
 from .records import GroundMotion, ModelScales, PlateDrive, ProcessingSettings, RecordError, process_record
 from vibroblock.excitation import BUNDLED_RECORD, PLAYBACK, Excitation, Playback
 
-__all__ = ["BUNDLED_SETTINGS", "INPUT_NAMES", "bundled_ground_motion", "communication_times", "excitation_of",
+__all__ = ["BUNDLED_SETTINGS", "HORIZONTAL_INPUT_NAMES", "INPUT_NAMES", "bundled_ground_motion", "communication_times", "excitation_of",
            "peak_scaled_parameters", "plate_input", "playback_parameters", "simulate_block", "write_bundled_record",
            "write_record"]
 
 INPUT_NAMES = ("plate_z", "plate_v", "plate_a")
+HORIZONTAL_INPUT_NAMES = ("plate_x", "plate_vx", "plate_ax")  # an oblique plate's (plate_motion = 1)
 # The bundled record: obspy's example event (BW.RJOB, vertical), band 1-20 Hz, which
 # keeps its local-event content (the velocity rises ~50x above the noise in 2-20 Hz).
 BUNDLED_SETTINGS = ProcessingSettings(freqmin=1.0, freqmax=20.0)
@@ -176,7 +177,8 @@ def excitation_of(source, scales: ModelScales | None = None, **parameters: float
 
 
 def plate_input(source, *, step_size: float | None = None, stop_time: float | None = None,
-                start_time: float = 0.0, scales: ModelScales | None = None, **parameters: float) -> np.ndarray:
+                start_time: float = 0.0, scales: ModelScales | None = None, horizontal=None,
+                **parameters: float) -> np.ndarray:
     """fmpy ``input`` array (``time, plate_z, plate_v, plate_a``) for a Block FMU.
 
     With ``step_size`` the motion is evaluated exactly at the communication points
@@ -185,9 +187,14 @@ def plate_input(source, *, step_size: float | None = None, stop_time: float | No
     linearly between table rows, which would make the three columns disagree).
     Without it a :class:`PlateDrive`'s own samples are packed as they are; run the
     block with ``output_interval = drive.dt`` then.
+
+    ``horizontal``: a second motion (of the same kinds as ``source``, played with the
+    same scales and parameters) for the plate's horizontal inputs ``plate_x, plate_vx,
+    plate_ax`` of a block with ``plate_motion = 1`` (oblique), e.g. the horizontal
+    component of a three-component record (``records.load_ground_motion_components``).
     """
     if step_size is None:
-        if not isinstance(source, PlateDrive) or parameters or scales is not None:
+        if not isinstance(source, PlateDrive) or parameters or scales is not None or horizontal is not None:
             raise ValueError("give step_size (the communication step) unless packing a PlateDrive as it is")
         columns = (source.time, source.displacement, source.velocity, source.acceleration)
     else:
@@ -201,7 +208,10 @@ def plate_input(source, *, step_size: float | None = None, stop_time: float | No
                 (p["onset"] + record.duration * p["time_scale"] - start_time) / step_size + 1e-9)
         times = communication_times(stop_time, step_size, start_time)
         columns = (times, *excitation.evaluate(times))
-    table = np.empty(len(columns[0]), dtype=[("time", float)] + [(name, float) for name in INPUT_NAMES])
+        if horizontal is not None:
+            columns += tuple(excitation_of(horizontal, scales, **parameters).evaluate(times))
+    names = INPUT_NAMES + (HORIZONTAL_INPUT_NAMES if len(columns) > 4 else ())
+    table = np.empty(len(columns[0]), dtype=[("time", float)] + [(name, float) for name in names])
     for name, values in zip(table.dtype.names, columns):
         table[name] = values
     return table

@@ -24,6 +24,11 @@ from .records import RecordError
 
 SCALED = {"k_d": 1e-2, "V_d": 1e-2, "gamma_t": 5e-3}  # model A's scaled stick-slip set (harness.runs.settings)
 OUTPUTS = ("x", "z", "vx", "normal_force", "contact", "coulomb_resets")
+# Integrators that take the plate as moving vertically (laws.plate_oblique refuses them), and
+# the one a three-component run takes instead: fourth order, and exact for the plate's
+# frame force between the communication points the inputs are held over.
+HORIZONTAL_REFUSED = ("adaptive", "event_driven")
+HORIZONTAL_INTEGRATOR = "rk4"
 # The run keeps its input table and outputs in memory (fmpy), ~0.2 kB a communication step:
 # beyond this many steps (~0.4 GB, a few minutes) the command asks for a shorter run instead.
 MAX_STEPS = 2_000_000
@@ -31,6 +36,8 @@ MAX_STEPS = 2_000_000
 MEANINGS = {
     "peak_plate_acceleration_g": "largest |plate acceleration|, in the block's g (> 1: the plate can throw it)",
     "peak_plate_displacement_delta0": "largest |plate height|, in delta_0 (the rest penetration)",
+    "peak_plate_horizontal_acceleration_g": "largest |plate acceleration along x| (--azimuth), in the block's g "
+                                            "(> mu_s: it can drag the block past its friction)",
     "contact_fraction": "share of the output samples with the block in contact",
     "min_normal_force_mg": "lowest normal force, in m g (0: the block left the plate)",
     "coulomb_resets": "breaks of the friction spring (|k_t F| >= mu_s N); one slip holds many",
@@ -63,6 +70,7 @@ class RecordRun:
     out_dir: str = str(REPO_ROOT / "out")
     save_record: str | None = None
     parameters: dict = field(default_factory=dict)
+    azimuth: float | None = None  # three components: the slip direction, degrees clockwise from north
 
     def __post_init__(self):
         for name in ("time_stretch", "mass", "stiffness", "step_size"):
@@ -73,6 +81,10 @@ class RecordRun:
             raise RecordError(f"stop time = {self.stop_time!r} must be a finite number > 0 (tau_0)")
         if self.peak_g is not None and not (math.isfinite(self.peak_g) and self.peak_g >= 0):
             raise RecordError(f"peak_g = {self.peak_g!r} must be a finite number >= 0 (in the block's g)")
+        if self.azimuth is not None and not math.isfinite(self.azimuth):
+            raise RecordError(f"azimuth = {self.azimuth!r} must be a finite number of degrees clockwise from north")
+        if self.azimuth is not None and self.save_record:
+            raise RecordError("--save-record writes one component; leave out --azimuth to save the vertical one")
 
     def block_fmu(self) -> Path:
         from harness.runs.settings import default_fmu
@@ -85,20 +97,31 @@ def run_record(settings: RecordRun, show_plot: bool = False) -> dict:
     """Run the block on the record; print what happened, save the figure; the results."""
     from harness.ground.excitation import plate_input, simulate_block, write_record
     from harness.ground.records import (ModelScales, ProcessingSettings, load_ground_motion,
-                                        scale_to_peak_acceleration)
+                                        load_ground_motion_components, scale_to_peak_acceleration)
 
     fmu = settings.block_fmu()
     read = {key: value for key, value in (("format", settings.format), ("inventory", settings.inventory),
                                           ("quantity", settings.quantity), ("unit", settings.unit),
                                           ("sensitivity", settings.sensitivity)) if value is not None}
-    motion = load_ground_motion(str(settings.record_file),
-                                ProcessingSettings(freqmin=settings.freqmin, freqmax=settings.freqmax), **read)
+    processing = ProcessingSettings(freqmin=settings.freqmin, freqmax=settings.freqmax)
+    horizontal = None
+    if settings.azimuth is None:
+        motion = load_ground_motion(str(settings.record_file), processing, **read)
+    else:
+        motion, horizontal = load_ground_motion_components(str(settings.record_file), settings.azimuth, processing,
+                                                           **read)
     scales = ModelScales.from_block(mass=settings.mass, normal_stiffness=settings.stiffness)
     if settings.peak_g is not None:
         # Played time_stretch times slower, accelerations shrink by time_stretch^2: the
-        # record is scaled so that the plate's peak is peak_g.
-        motion = scale_to_peak_acceleration(motion, settings.peak_g * settings.time_stretch ** 2,
-                                            gravity=scales.gravity)
+        # record is scaled so that the plate's peak is peak_g (with two components, the
+        # larger one's, both by the same factor).
+        peak = settings.peak_g * settings.time_stretch ** 2
+        if horizontal is not None:
+            larger = max(motion.peak_acceleration, horizontal.peak_acceleration)
+            motion, horizontal = (scale_to_peak_acceleration(m, peak * m.peak_acceleration / larger,
+                                                             gravity=scales.gravity) for m in (motion, horizontal))
+        else:
+            motion = scale_to_peak_acceleration(motion, peak, gravity=scales.gravity)
     if settings.save_record:
         print(f"saved the processed record (SI) for the Excitation FMU's record_file: "
               f"{write_record(motion, settings.save_record)}")
@@ -126,9 +149,17 @@ def run_record(settings: RecordRun, show_plot: bool = False) -> dict:
     elif stop > duration + step:
         notes.append(f"the run ({stop:g} tau_0) is longer than the processed record ({duration:.6g} tau_0 = "
                      f"{record_seconds:.4g} s): after it the plate rests")
-    table = plate_input(motion, scales=scales, step_size=step, stop_time=stop, time_scale=time_scale)
-    start_values = {**(SCALED if settings.model.upper() == "A" else {}), **settings.parameters,
-                    "integrator": _integrator_code(fmu, settings.integrator)}
+    table = plate_input(motion, scales=scales, step_size=step, stop_time=stop, time_scale=time_scale,
+                        horizontal=horizontal)
+    integrator = settings.integrator
+    start_values = {**(SCALED if settings.model.upper() == "A" else {}), **settings.parameters}
+    if horizontal is not None:
+        start_values["plate_motion"] = 1  # the oblique plate: its horizontal inputs move it along x
+        if integrator in HORIZONTAL_REFUSED:
+            notes.append(f"the horizontal component needs a fixed-step integrator ({integrator} takes the plate "
+                         f"as moving vertically): running {HORIZONTAL_INTEGRATOR}")
+            integrator = HORIZONTAL_INTEGRATOR
+    start_values["integrator"] = _integrator_code(fmu, integrator)
     result = simulate_block(fmu, table, start_values=start_values, outputs=OUTPUTS)
 
     a = table["plate_a"]
@@ -144,15 +175,19 @@ def run_record(settings: RecordRun, show_plot: bool = False) -> dict:
         "drive_advance_delta0": _drive_advance(start_values, stop),
         "min_normal_force_mg": float(np.min(result["normal_force"])),
     }
+    if horizontal is not None:
+        summary["peak_plate_horizontal_acceleration_g"] = float(np.max(np.abs(table["plate_ax"])))
     print(f"record: {motion.source} ({motion.trace_id or 'one channel'}), {motion.time.size} samples at "
           f"{1 / motion.dt:g} Hz, {record_seconds:.4g} s after processing")
     print(f"block:  {settings.mass:g} kg on {settings.stiffness:g} N/m, so delta_0 = {scales.length_scale:.4g} m and "
           f"tau_0 = {scales.time_scale:.4g} s; the record is played {_pace(settings.time_stretch)}")
-    print(f"run:    model {settings.model.upper()}, integrator {settings.integrator}, {stop:g} tau_0 "
+    print(f"run:    model {settings.model.upper()}, integrator {integrator}, {stop:g} tau_0 "
           f"(= {stop / time_scale:.4g} s of the record), communication step {step:g} tau_0")
     for note in notes:
         print(f"note:   {note}")
     for key, meaning in MEANINGS.items():
+        if key not in summary:
+            continue
         value = summary[key]
         print(f"  {key:31s} {value:<12.5g} {meaning}" if isinstance(value, float) else
               f"  {key:31s} {value:<12d} {meaning}")
@@ -192,7 +227,10 @@ def _plot(settings, motion, scales, table, result, start_values, time_scale, sho
 
     t = table["time"]
     fig, axes = plt.subplots(4, 1, figsize=(7.0, 8.4), sharex=True)
-    axes[0].plot(t, table["plate_a"], lw=0.6, color="tab:gray")
+    axes[0].plot(t, table["plate_a"], lw=0.6, color="tab:gray", label="vertical")
+    if "plate_ax" in table.dtype.names:
+        axes[0].plot(t, table["plate_ax"], lw=0.6, color="tab:orange", label=f"along x ({settings.azimuth:g} deg)")
+        axes[0].legend(fontsize=8)
     axes[0].set_ylabel("plate acceleration [g]")
     name = motion.trace_id or Path(str(settings.record_file)).name
     # The title above the figure: the record's seconds run along the top of the first panel.
@@ -239,6 +277,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--quantity", help="what the samples are: acceleration, velocity or displacement (text "
                                            "files, physical units, or with --sensitivity)")
     parser.add_argument("--unit", help="unit of the samples (or of --sensitivity), e.g. m/s^2, g, cm/s")
+    parser.add_argument("--azimuth", type=float,
+                        help="three-component record: shake the plate with its vertical channel and, along x, with "
+                             "the horizontal motion at this azimuth (degrees clockwise from north; channels N, E, or "
+                             "1, 2 with --inventory); needs a fixed-step integrator (rk4 is taken)")
     parser.add_argument("--peak-g", type=float, help="rescale so that the plate's peak acceleration is this, in the "
                                                       "block's g (after --time-stretch)")
     parser.add_argument("--time-stretch", type=float, default=1.0,
@@ -273,4 +315,4 @@ def settings_from(args) -> RecordRun:
                      sensitivity=args.sensitivity, peak_g=args.peak_g, time_stretch=args.time_stretch,
                      mass=args.mass, stiffness=args.stiffness, freqmin=args.freqmin, freqmax=args.freqmax,
                      step_size=args.step, stop_time=args.stop_time, out_dir=args.out, save_record=args.save_record,
-                     parameters=parameters)
+                     parameters=parameters, azimuth=args.azimuth)

@@ -18,6 +18,9 @@ A record file becomes a plate drive in three steps::
   zero-phase band-pass, integration, baseline correction; the result
   :class:`GroundMotion` holds consistent acceleration, velocity and
   displacement in SI. :func:`scale_to_peak_acceleration` rescales.
+* :mod:`.components` — :func:`load_ground_motion_components`: a
+  three-component record as its vertical motion and its horizontal motion
+  along a slip azimuth, each channel processed as above.
 * :mod:`.model_units` — :class:`ModelScales` (δ₀ = m g/k_n metres and
   τ₀ = √(m/k_n) seconds per model unit; worked example in that module) and
   :func:`to_model_grid` for a uniform model-time grid.
@@ -27,6 +30,7 @@ Every failure about a record or a setting raises :class:`RecordError` with a
 message that says what is wrong and what to do.
 """
 
+from .components import load_ground_motion_components
 from .errors import RecordError
 from .model_units import BLOCK_GRAVITY, ModelScales, PlateDrive, to_model_grid
 from .processing import (
@@ -54,6 +58,7 @@ __all__ = [
     "STANDARD_GRAVITY",
     "integrate_linear_acceleration",
     "load_ground_motion",
+    "load_ground_motion_components",
     "parse_quantity",
     "process_record",
     "read_record",

@@ -237,3 +237,44 @@ def test_state_round_trip_and_a_changed_record_is_refused(tmp_path):
         Excitation.from_state(state)
     # a record already in memory is reused when it is the same
     assert Excitation.from_state(state, known=plate.record).outputs() == plate.outputs()
+
+
+@pytest.mark.parametrize("mode", [0, LINEAR_CHIRP, HARMONIC_SUM])
+def test_a_direction_splits_the_signal_into_its_vertical_and_horizontal_parts(mode):
+    """plate_z = cos(direction) f, plate_x = sin(direction) f, for the kinematics alike; at
+    direction 0 the vertical motion is the signal's own, to the bit, and plate_x is 0."""
+    settings = dict(amplitude=0.7, omega=0.4, amplitude_1=0.2, omega_1=0.3)
+    times = np.linspace(0.0, 60.0, 241)
+    along = Excitation(mode=mode, **settings)
+    along.start()
+    vertical = along.evaluate(times)
+    assert np.all(np.asarray(along.evaluate_horizontal(times)) == 0.0)
+    direction = math.radians(35.0)
+    oblique = Excitation(mode=mode, direction=direction, **settings)
+    oblique.start()
+    for part, factor in ((oblique.evaluate(times), math.cos(direction)),
+                         (oblique.evaluate_horizontal(times), math.sin(direction))):
+        for got, signal in zip(part, vertical):
+            np.testing.assert_allclose(got, factor * signal, rtol=1e-15, atol=1e-15)
+    assert set(oblique.outputs()) == {"plate_z", "plate_v", "plate_a", "plate_x", "plate_vx", "plate_ax"}
+
+
+def test_a_record_s_own_horizontal_component_plays_as_plate_x_on_the_same_clock():
+    """use_record(vertical, horizontal=...): plate_z plays the vertical record unscaled by
+    the direction, plate_x the horizontal one; the state carries both and refuses a
+    restore without the same horizontal component."""
+    dt = 0.01
+    t = np.arange(0, 400) * dt
+    vertical = Playback(np.sin(3 * t) * np.exp(-t), dt)
+    horizontal = Playback(np.cos(5 * t) * np.exp(-t), dt)
+    plate = Excitation(mode=PLAYBACK, direction=1.0)
+    plate.use_record(vertical, "quake", horizontal=horizontal)
+    plate.start()
+    times = np.linspace(0.0, 5.0, 51)
+    np.testing.assert_array_equal(plate.evaluate(times)[2], vertical(times)[2])
+    np.testing.assert_array_equal(plate.evaluate_horizontal(times)[2], horizontal(times)[2])
+    state = plate.get_state()
+    again = Excitation.from_state(state, known=vertical, known_horizontal=horizontal)
+    assert again.outputs() == plate.outputs()
+    with pytest.raises(ExcitationError, match="horizontal component"):
+        Excitation.from_state(state, known=vertical)
