@@ -16,6 +16,7 @@ from harness.cosim.masters import run_libcosim
 from vibroblock.excitation import Excitation, load_record
 
 PLATE = ["plate_z", "plate_v", "plate_a"]
+ALONG_X = ["plate_x", "plate_vx", "plate_ax"]
 CHIRP = {"mode": 2, "amplitude": 1.5, "omega_start": 0.1, "omega_end": 1.0, "sweep_time": 60.0, "ramp_time": 5.0,
          "onset": 2.0}
 
@@ -71,7 +72,7 @@ def test_fmpy_validation_reports_nothing(excitation_fmu):
     assert kinds["record_file"] == ("String", "parameter", "fixed")
     for name in ("amplitude_scale", "time_scale", "onset", "ramp_time", "omega_end", "amplitude_4"):
         assert kinds[name] == ("Real", "parameter", "fixed")
-    assert {n for n, k in kinds.items() if k[1] == "output"} == set(PLATE)
+    assert {n for n, k in kinds.items() if k[1] == "output"} == set(PLATE + ALONG_X)
 
 
 @pytest.mark.parametrize("settings", [
@@ -80,16 +81,19 @@ def test_fmpy_validation_reports_nothing(excitation_fmu):
     {"mode": 1, "amplitude": 1.0, "omega_start": 0.2, "omega_end": 0.05, "sweep_time": 40.0, "time_scale": 2.0},
     {"mode": 3, "amplitude_1": 1.0, "omega_1": 0.2, "amplitude_2": 0.3, "omega_2": 0.9, "phase_2": 1.0},
     {"mode": 4, "amplitude_scale": 1e6, "time_scale": 2.0, "onset": 3.0},
-], ids=["harmonic", "log_chirp", "linear_chirp_down", "sum", "playback_bundled"])
+    {"mode": 0, "amplitude": 2.0, "omega": 0.3, "phase": 0.5, "direction": 0.6},
+], ids=["harmonic", "log_chirp", "linear_chirp_down", "sum", "playback_bundled", "oblique"])
 def test_outputs_equal_the_core(excitation_fmu, settings):
-    result = simulate_fmu(excitation_fmu, stop_time=80.0, output_interval=0.25, start_values=settings)
+    result = simulate_fmu(excitation_fmu, stop_time=80.0, output_interval=0.25, start_values=settings,
+                          output=PLATE + ALONG_X)
     core = Excitation(**settings)
     core.start()
-    expected = core.evaluate(result["time"])
-    for name, values in zip(PLATE, expected):
+    expected = (*core.evaluate(result["time"]), *core.evaluate_horizontal(result["time"]))
+    for name, values in zip(PLATE + ALONG_X, expected):
         np.testing.assert_allclose(result[name], values, rtol=1e-13, atol=1e-13 * np.max(np.abs(values)),
                                    err_msg=name)
     assert np.max(np.abs(result["plate_a"])) > 1e-3
+    assert (np.max(np.abs(result["plate_ax"])) > 1e-3) == ("direction" in settings)
 
 
 def test_fmu_outputs_are_kinematically_consistent(excitation_fmu):

@@ -189,3 +189,29 @@ def test_a_three_component_record_shakes_the_plate_vertically_and_along_its_slip
         pytest.approx(ratio, rel=0.05)
     if peaks["peak_plate_horizontal_acceleration_g"] > 0.5:
         assert result["coulomb_resets"] > 0
+
+
+def test_the_excitation_fmu_plays_a_three_component_record_s_vertical_and_horizontal_motions(quick_fmus, tmp_path):
+    """record_components = 2: plate_z plays the vertical channel, plate_x the horizontal
+    motion along record_azimuth, both as harness.ground.records computes them;
+    record_components = 2 outside a seismic playback fails the initialization."""
+    from fmpy import simulate_fmu
+
+    from harness.ground.records import load_ground_motion_components
+
+    obspy.read().write(str(tmp_path / "rjob.mseed"), format="MSEED")
+    obspy.read_inventory().write(str(tmp_path / "rjob.xml"), format="STATIONXML")
+    fmu = str(quick_fmus / "Excitation.fmu")
+    settings = {"mode": 4, "record_file": str(tmp_path / "rjob.mseed"), "record_inventory": str(tmp_path / "rjob.xml"),
+                "record_components": 2, "record_azimuth": 30.0, "amplitude_scale": 1.0, "time_scale": 1.0}
+    played = simulate_fmu(fmu, stop_time=30.0, output_interval=0.01, start_values=settings,
+                          output=["plate_z", "plate_a", "plate_x", "plate_ax"])
+    vertical, horizontal = load_ground_motion_components(str(tmp_path / "rjob.mseed"), 30.0,
+                                                         inventory=str(tmp_path / "rjob.xml"))
+    index = np.round(played["time"] / vertical.dt).astype(int)
+    for name, motion in (("plate_a", vertical), ("plate_ax", horizontal)):
+        np.testing.assert_allclose(played[name], motion.acceleration[index], rtol=0,
+                                   atol=1e-9 * motion.peak_acceleration, err_msg=name)
+    assert np.max(np.abs(played["plate_ax"])) > 0.1 * np.max(np.abs(played["plate_a"]))
+    with pytest.raises(Exception):
+        simulate_fmu(fmu, stop_time=1.0, start_values={"mode": 0, "record_components": 2})
