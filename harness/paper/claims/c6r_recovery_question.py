@@ -44,7 +44,8 @@ from harness.runs.continuation import Ramp
 from harness.runs.settings import InitialCondition, Integration, ObservableSettings, PointSettings
 from harness.runs.sweep import Axis, Grid
 
-from .measure import CREST, SCALED, friction_held, observe_json, ramp_task, relaxed_start, run_and_measure
+from .measure import (CREST, CROSSOVER, SCALED, foot_bracket, friction_held, locate_feet, observe_json, phi_curve,
+                      ramp_task, relaxed_start, run_and_measure, transition_character)
 from .study import Claim, Runner, Study
 from .verdicts import AGREES, DISAGREES, NOT_REPRODUCED, Row, combine, fmt
 
@@ -148,17 +149,47 @@ def _run(runner: Runner, configuration: Configuration, amplitude: float, **value
                       start_time=relaxed_start(CREST, parameters["V_d"]))
 
 
-def _held_along_omega(runner: Runner, base: PointSettings, omegas) -> list[bool]:
+def _observe_along_omega(runner: Runner, base: PointSettings, omegas) -> list[dict]:
+    """Observables of the runs at ``omegas`` (each a cached task)."""
     items = [{"point": PointSettings(run=base.run.with_parameters({"omega": float(w)}), observe=base.observe)}
              for w in omegas]
-    return [friction_held(r["observables"]["regime"]) for r in runner.tasks(run_and_measure, items)]
+    return [r["observables"] for r in runner.tasks(run_and_measure, items)]
 
 
-def _transitions(runner: Runner, base: PointSettings, omegas, regimes) -> list[dict]:
+def _transitions(runner: Runner, base: PointSettings, curve: dict, omegas, regimes) -> list[dict]:
+    """Every class change along omega, bisected to RECOVERY_RESOLUTION and called sharp or
+    a crossover (:func:`.measure.transition_character`); a crossover's foot, where phi
+    reaches the floor of sliding with the drive on its sliding side, is bisected to the
+    same resolution.  ``boundary``: the located value of a sharp change, the foot of a
+    crossover (its located threshold crossing where no foot was found).  ``curve``
+    ({omega: observables}) gains every run."""
     held = [friction_held(r) for r in regimes]
-    found = locate_transitions(lambda points: _held_along_omega(runner, base, points), omegas, held,
-                               resolution=RECOVERY_RESOLUTION)
-    return [t.as_dict() for t in found]
+
+    def classify(points):
+        observed = _observe_along_omega(runner, base, points)
+        curve.update(zip((float(p) for p in points), observed))
+        return [friction_held(o["regime"]) for o in observed]
+
+    found = [t.as_dict() for t in locate_transitions(classify, omegas, held, resolution=RECOVERY_RESOLUTION)]
+    threshold = base.observe.phi_threshold
+    searches = []
+    for t in found:
+        held_side, other_side = (t["lo"], t["hi"]) if t["held_lo"] else (t["hi"], t["lo"])
+        t["character"] = transition_character(curve[held_side], curve[other_side], threshold)
+        t["foot"] = t["foot_bracket"] = None
+        if t["character"] == CROSSOVER:
+            # The sliding side lies above a loss and below a recovery.
+            bracket = foot_bracket(curve, other_side, t["held_lo"], threshold)
+            if bracket is not None:
+                searches.append({"transition": t, "curve": curve, "bracket": bracket, "upward": t["held_lo"]})
+    if searches:
+        locate_feet(lambda pairs: _observe_along_omega(runner, base, [w for _, w in pairs]), searches, threshold,
+                    RECOVERY_RESOLUTION)
+    for search in searches:
+        search["transition"].update(foot=search["foot"], foot_bracket=search["foot_bracket"])
+    for t in found:
+        t["boundary"] = t["foot"] if t["character"] == CROSSOVER and t["foot"] is not None else t["value"]
+    return found
 
 
 def _closest(value: float, candidates: list[float]) -> float | None:
@@ -171,20 +202,25 @@ def _row(runner: Runner, configuration: Configuration, amplitude: float, omegas,
                          observe=configuration.observe)
     ds = runner.sweep(Grid((Axis("omega", omegas),)), base)
     regimes = ds.regime.values.tolist()
-    transitions = _transitions(runner, base, list(omegas), regimes)
+    curve = {float(w): {"phi": float(p), "contact_fraction": float(c)}
+             for w, p, c in zip(omegas, ds.phi.values, ds.contact_fraction.values)}
+    transitions = _transitions(runner, base, curve, list(omegas), regimes)
     candidates = predictions(amplitude, k_n=k_n, gamma_n=gamma_n, load=LOAD)
     losses = [t for t in transitions if t["kind"] == LOSS]
-    omega_1 = losses[0]["value"] if losses else None
+    omega_1 = losses[0]["boundary"] if losses else None
     # omega_2: friction regained above the first loss.
-    recoveries = [t for t in transitions if t["kind"] == RECOVERY and omega_1 is not None and t["value"] > omega_1]
-    omega_2 = recoveries[0]["value"] if recoveries else None
+    recoveries = [t for t in transitions if t["kind"] == RECOVERY and omega_1 is not None and t["boundary"] > omega_1]
+    omega_2 = recoveries[0]["boundary"] if recoveries else None
     return {"configuration": configuration.label, "A": amplitude, "k_n": k_n, "gamma_n": gamma_n,
             "omegas": list(omegas), "regimes": regimes,
             "contact_fraction": ds.contact_fraction.values.tolist(), "phi": ds.phi.values.tolist(),
             "slope_angle_end": ds.slope_angle_end.values.tolist(),
             "transitions": transitions, "omega_1": omega_1, "omega_2": omega_2,
+            "omega_2_character": recoveries[0]["character"] if recoveries else None,
+            "omega_1_character": losses[0]["character"] if losses else None,
             "omega_2_resolution": recoveries[0]["resolution"] if recoveries else None,
-            "loss_above_omega_2": next((t["value"] for t in losses if omega_2 and t["value"] > omega_2), None),
+            "loss_above_omega_2": next((t["boundary"] for t in losses if omega_2 and t["boundary"] > omega_2), None),
+            "phi_curve": phi_curve(curve),
             **candidates}
 
 
@@ -269,9 +305,14 @@ def verdict_rows(m: dict) -> list:
         return (f"; jammed at {len(angles)}/{len(r['regimes'])} grid omegas, on slopes of {min(angles):.0f} to "
                 f"{max(angles):.0f} deg") if angles else ""
 
+    def character(r, part):
+        kind = r.get(f"{part}_character")
+        return f" ({kind}{', at its foot' if kind == CROSSOVER else ''})" if kind else ""
+
     def located(r):
-        return (f"{r['configuration']}, A = {r['A']:g}: friction lost at {fmt(r['omega_1'])}, back at "
-                f"{fmt(r['omega_2'])}, lost again at {fmt(r['loss_above_omega_2'])} (A_N roots "
+        return (f"{r['configuration']}, A = {r['A']:g}: friction lost at {fmt(r['omega_1'])}{character(r, 'omega_1')}, "
+                f"back at {fmt(r['omega_2'])}{character(r, 'omega_2')}, lost again at "
+                f"{fmt(r['loss_above_omega_2'])} (A_N roots "
                 + ", ".join(f"{w:.3g}" for w in r["A_N_roots"]) + "; A_c roots "
                 + ", ".join(f"{w:.3g}" for w in r["A_c_roots"]) + ")" + jams(r))
 
@@ -394,11 +435,12 @@ def draw(study: Study, save) -> None:
                 # Colours and markers of their own: the regimes' colours mean regimes only.
                 lost = t["kind"] == LOSS
                 style = TRANSITION_STYLE[lost]
-                ax.plot([t["value"]], [level * 1.5], marker=style["marker"], color=style["color"], ms=7,
+                at = t.get("boundary", t["value"])  # a crossover's foot, a sharp change's located value
+                ax.plot([at], [level * 1.5], marker=style["marker"], color=style["color"], ms=7,
                         label=None if style["label"] in shown else style["label"])
                 shown.add(style["label"])
                 # The value above its marker, offset in points so that it never covers one.
-                ax.annotate(f"{t['value']:.3g}", (t["value"], level * 1.5), xytext=(0, 7), textcoords="offset points",
+                ax.annotate(f"{at:.3g}", (at, level * 1.5), xytext=(0, 7), textcoords="offset points",
                             ha="center", va="bottom", fontsize=7, color=style["color"])
         ax.set(xscale="log", yscale="log", ylim=(0.05, 3.0), xlabel="$\\omega$ [$\\tau_0^{-1}$]",
                ylabel="$A$ [$\\delta_0$]", title=label)

@@ -289,3 +289,93 @@ def recovery(values: Sequence[float], regimes: Sequence[str]) -> dict:
             out["last_sliding"] = float(values[i - 1])
             break
     return out
+
+
+# ---------------------------------------------------------------------- sharp or crossover
+# A class change located by bisection is either a sharp transition, where phi jumps across
+# the last bracket (the applied-load bound's recovery at the A_c root: phi 0.04 -> 187
+# over 2.5 % in omega), or a crossover, where phi falls continuously through the regime
+# threshold with the block in contact on both sides (A -> A_N under the contact-force
+# bound: phi 61, 47, 20, 12, 7.2, 3.5, 1.0, 0.005 over A = 0.5 ... 0.82 at omega = 2.52).
+# Where phi crosses a level in a crossover is a property of the level, not of the model,
+# so a crossover is reported by its phi curve and by its foot, where phi reaches the floor
+# of sliding with the drive, set against the physical marker (N_min -> 0 at A_N).
+SHARP, CROSSOVER = "sharp", "crossover"
+# phi changes by at least this many decades across a sharp transition's last bracket (3 %
+# wide).  A smooth curve crossing the threshold changes by (1.03)^s over it, s = dln phi /
+# dln A: 1.24 (0.09 decades) at the crossover above, where s ~ 7; one decade needs s ~ 78.
+SHARP_DECADES = 1.0
+# phi of a block sliding with the drive, as a share of the regime threshold: the crossover
+# above ends at 0.005 (5e-4 of the threshold 10) from 1.0 (0.1 of it) one step before.
+FLOOR_FRACTION = 0.01
+IN_CONTACT = 0.99  # contact fraction of a block "in contact throughout"
+
+
+def _finite_phi(value) -> float | None:
+    return float(value) if value is not None and math.isfinite(float(value)) else None
+
+
+def transition_character(held_side: dict, other_side: dict, threshold: float) -> str:
+    """``SHARP`` or ``CROSSOVER`` for a located class change, from the runs on its two sides
+    (each {"phi", "contact_fraction"}: observables): a crossover when the block is in
+    contact on both sides, phi lies above ``threshold`` on the held side and below it on
+    the other (the class changed because phi crossed the threshold) and changes by less
+    than ``SHARP_DECADES`` across the bracket; sharp otherwise."""
+    phi_held, phi_other = _finite_phi(held_side.get("phi")), _finite_phi(other_side.get("phi"))
+    contacts = [held_side.get("contact_fraction"), other_side.get("contact_fraction")]
+    if phi_held is None or phi_other is None or any(c is None or not c >= IN_CONTACT for c in contacts):
+        return SHARP
+    if not phi_held > threshold >= phi_other:
+        return SHARP
+    decades = math.log10(phi_held / max(phi_other, threshold * 1e-9))
+    return CROSSOVER if decades < SHARP_DECADES else SHARP
+
+
+def above_floor(observables: dict, threshold: float) -> bool:
+    """phi above the floor of sliding with the drive (``FLOOR_FRACTION`` of the threshold);
+    a run without a finite phi (no contact) is not."""
+    phi = _finite_phi(observables.get("phi"))
+    return phi is not None and phi > FLOOR_FRACTION * threshold
+
+
+def foot_bracket(curve: dict, start: float, upward: bool, threshold: float) -> tuple[float, float] | None:
+    """The crossover's foot on the measured curve {value: observables}: walking from
+    ``start`` (the sliding side of the located threshold crossing) away from the held side
+    (towards higher values if ``upward``), the first pair of neighbours whose phi falls
+    from above the floor to the floor (ascending (lo, hi)); None if the curve never
+    reaches the floor there."""
+    values = sorted(v for v in curve if (v >= start if upward else v <= start))
+    if not upward:
+        values = values[::-1]
+    for near, far in zip(values[:-1], values[1:]):
+        if above_floor(curve[near], threshold) and not above_floor(curve[far], threshold):
+            return (near, far) if upward else (far, near)
+    return None
+
+
+def locate_feet(measure, searches: list[dict], threshold: float, resolution: float) -> None:
+    """Bisect each crossover's foot bracket to ``resolution``, all searches per round in one
+    batch.  ``searches``: dicts with "curve" ({value: observables}, extended in place),
+    "bracket" (lo, hi) from :func:`foot_bracket` and "upward"; ``measure(pairs)``
+    runs (search, value) pairs and returns their observables.  Adds "foot" (the located
+    value) and "foot_bracket" to each search."""
+    from harness.runs.bisection import Transition, refine
+
+    found = [Transition(s["bracket"][0], s["bracket"][1], s["upward"], where={"search": n})
+             for n, s in enumerate(searches)]
+
+    def classify(pairs):
+        observed = measure([(searches[t.where["search"]], value) for t, value in pairs])
+        for (t, value), o in zip(pairs, observed):
+            searches[t.where["search"]]["curve"][value] = o
+        return [above_floor(o, threshold) for o in observed]
+
+    refine(classify, found, resolution)
+    for search, t in zip(searches, found):
+        search["foot"], search["foot_bracket"] = t.value, [t.lo, t.hi]
+
+
+def phi_curve(curve: dict) -> list[list[float | None]]:
+    """The curve {value: observables} as ascending [value, phi, contact fraction] rows (JSON)."""
+    return [[float(v), _finite_phi(curve[v].get("phi")), _finite_phi(curve[v].get("contact_fraction"))]
+            for v in sorted(curve)]
