@@ -68,8 +68,13 @@ def study_c6(runner: Runner) -> Study:
     k_t_zero = {"point": PointSettings(run=c_run(runner, max(res.c_horizon, 8000.0), A=0.0, k_t=0.0),
                                        observe=observe_c), "extras": ["trace"]}
     ramp_amplitude = 0.5
+    # The ramp runs across the linear theory's recovery (the upper A_c root at this A) as
+    # well as across k_n/gamma_n.
+    ramp_theory = theory_roots(ramp_amplitude)
+    ramp_values = tuple(sorted(set(res.c6_ramp) | {round(w * f, 4) for w in ramp_theory["A_c_roots"][1:]
+                                                     for f in (1 / BRACKET, 1.0, BRACKET)}))
     ramp_item = {"point": PointSettings(run=c_run(runner, res.c6_ramp_step, A=ramp_amplitude), observe=observe_c),
-                 "ramp": Ramp("omega", res.c6_ramp)}
+                 "ramp": Ramp("omega", ramp_values)}
     [frictionless] = runner.tasks(run_and_measure, [k_t_zero])
     [loop] = runner.tasks(ramp_task, [ramp_item])
 
@@ -77,15 +82,18 @@ def study_c6(runner: Runner) -> Study:
     diagram = runner.sweep(Grid((Axis("A", res.c6_amplitudes), Axis("omega", res.c6_omegas))), base)
     rows = []
     for amplitude in diagram.A.values:
-        regimes = diagram.regime.sel(A=amplitude).values.tolist()
-        omegas = diagram.omega.values.tolist()
+        theory = theory_roots(float(amplitude))
+        omegas, regimes = _bracketing(runner, base, {"A": float(amplitude)}, diagram.omega.values.tolist(),
+                                      diagram.regime.sel(A=amplitude).values.tolist(), theory["bracketed"])
         found = recovery(omegas, regimes)
-        rows.append({"A": float(amplitude), "regimes": regimes, **found,
+        rows.append({"A": float(amplitude), "omegas": omegas, "regimes": regimes, **found,
                      "first_transition_paper": math.sqrt(1.0 / float(amplitude)),
-                     "first_transition_onset": onset_omega(float(amplitude), 0.07)})
+                     "first_transition_onset": onset_omega(float(amplitude), 0.07), "theory": theory})
     _locate_transitions(runner, base, rows)
+    # Every reading: a boundary that depends on the start is no property of the model in
+    # any reading.
     ensemble = (_check_by_start_ensemble(runner, rows, res.ensemble_wavelengths)
-                if res.ensemble_wavelengths > 0 and runner.reading == DEFAULT_READING else None)
+                if res.ensemble_wavelengths > 0 else None)
 
     stiffness_amplitude = 0.5
     base_k = PointSettings(run=c_run(runner, res.c_horizon, A=stiffness_amplitude), observe=observe_c)
@@ -96,11 +104,13 @@ def study_c6(runner: Runner) -> Study:
     recovery_vs_k = []
     for ratio in stiff.ratio.values:
         for k_n in stiff.k_n.values:
-            regimes = stiff.regime.sel(ratio=ratio, k_n=k_n).values.tolist()
-            omegas = (stiff.relative_omega.values * ratio).tolist()
+            theory = theory_roots(stiffness_amplitude, k_n=float(k_n), gamma_n=float(k_n / ratio))
+            omegas, regimes = _bracketing(runner, base_k, {"k_n": float(k_n), "gamma_n": float(k_n / ratio)},
+                                          (stiff.relative_omega.values * ratio).tolist(),
+                                          stiff.regime.sel(ratio=ratio, k_n=k_n).values.tolist(), theory["bracketed"])
             found = recovery(omegas, regimes)
             recovery_vs_k.append({"ratio": float(ratio), "k_n": float(k_n), "regimes": regimes, "omegas": omegas,
-                                  **found})
+                                  **found, "theory": theory})
 
     up = [(v, r) for d, v, r in zip(loop["direction"], loop["value"], loop["regime"]) if d == "up"]
     down = [(v, r) for d, v, r in zip(loop["direction"], loop["value"], loop["regime"]) if d == "down"]
@@ -116,7 +126,7 @@ def study_c6(runner: Runner) -> Study:
                          "drift_velocity": frictionless["observables"]["drift_velocity"]},
         "diagram_rows": rows, "omegas": diagram.omega.values.tolist(), "resolution": BOUNDARY_RESOLUTION,
         "stiffness_amplitude": stiffness_amplitude, "recovery_vs_k": recovery_vs_k,
-        "ramp_amplitude": ramp_amplitude, "ramp_values": list(res.c6_ramp),
+        "ramp_amplitude": ramp_amplitude, "ramp_values": list(ramp_values), "ramp_theory": ramp_theory,
         "ramp_up_omega_2": up_rec["omega_2"],
         "ramp_down_omega_2": min(down_friction_above) if down_friction_above else None,
         "ramp_up_regimes": [r for _, r in up], "ramp_down_regimes": [r for _, r in down],
@@ -129,6 +139,38 @@ def study_c6(runner: Runner) -> Study:
             "regime": diagram.regime.transpose("A", "omega").values.tolist(),
             "recovery_vs_k": recovery_vs_k, "loop": loop}
     return Study("C6", measured, settings, data)
+
+
+BRACKET = 1.1  # extra omegas at each predicted root / and * this factor
+
+
+def theory_roots(amplitude: float, k_n: float = 1.0, gamma_n: float = 0.07, load: float = 1.0) -> dict:
+    """What linear theory predicts for a row at plate amplitude ``amplitude`` (m = 1): the
+    paper's first transition sqrt(P_l/(m A)), the roots of A_c(omega) = A (detachment:
+    friction lost between the lower and regained at the upper with the applied-load
+    bound) and of A_N(omega) = A (the contact force's zero, the same with the
+    contact-force bound), and k_n/gamma_n; ``bracketed``: the omegas the row must run
+    so that each prediction lies between two of its runs."""
+    from .c6r_recovery_question import crossings
+
+    a_c = crossings(lambda w: onset_amplitude(w, load, 1.0, k_n, gamma_n), amplitude)
+    a_n = crossings(lambda w: loss_amplitude(w, load, 1.0, k_n, gamma_n), amplitude)
+    paper = math.sqrt(load / amplitude)
+    predicted = [paper, *a_c, *a_n]
+    return {"paper_omega_1": paper, "A_c_roots": a_c, "A_N_roots": a_n, "k_n_over_gamma_n": k_n / gamma_n,
+            "bracketed": sorted({round(w * f, 4) for w in predicted for f in (1 / BRACKET, BRACKET)})}
+
+
+def _bracketing(runner: Runner, base: PointSettings, where: dict, omegas: list, regimes: list, extra: list):
+    """The row's omegas and regimes with the runs at ``extra`` omegas inside the grid's range
+    (cached tasks) merged in, ascending."""
+    extra = [w for w in extra if min(omegas) < w < max(omegas) and w not in omegas]
+    items = [{"point": PointSettings(run=base.run.with_parameters({**where, "omega": w}), observe=base.observe)}
+             for w in extra]
+    found = {float(w): r for w, r in zip(omegas, regimes)}
+    found.update({w: r["observables"]["regime"] for w, r in zip(extra, runner.tasks(run_and_measure, items))})
+    ordered = sorted(found)
+    return ordered, [found[w] for w in ordered]
 
 
 def _locate_transitions(runner: Runner, base: PointSettings, rows: list[dict]) -> None:
@@ -212,6 +254,25 @@ def _with_ensemble(verdict: str, reason: str, part: tuple[str, str] | None) -> t
     return verdict, f"{reason}; {part[1]}"
 
 
+def _upper(roots: list) -> float | None:
+    """The upper root of a band (friction regained there), None without a band."""
+    return roots[1] if len(roots) >= 2 else None
+
+
+def _theory_text(row: dict, recovery_only: bool = False) -> str:
+    """What linear theory predicts for the row, beside what was measured."""
+    theory = row.get("theory")
+    if not theory:
+        return ""
+    a_c, a_n = theory["A_c_roots"], theory["A_N_roots"]
+    if recovery_only:
+        return (f" (theory: upper A_c root {fmt(_upper(a_c))} with the applied-load bound, upper A_N root "
+                f"{fmt(_upper(a_n))} with the contact-force bound, k_n/gamma_n {theory['k_n_over_gamma_n']:.3g}"
+                + ("; no band below delta_0, no recovery predicted" if len(a_c) < 2 else "") + ")")
+    return (" [theory: A_c(w) = A at " + (", ".join(f"{w:.3g}" for w in a_c) or "none")
+            + "; A_N(w) = A at " + (", ".join(f"{w:.3g}" for w in a_n) or "none") + "]")
+
+
 def _near(row: dict, line: float) -> bool:
     """``line`` agrees with the row's first transition: within FORMULA_TOLERANCE of the located
     omega_1, or (nothing located) inside the grid bracket."""
@@ -239,7 +300,8 @@ def verdict_c6(m: dict) -> list[Row]:
     measured = "; ".join(f"A = {r['A']:g}: friction lost at w in ({fmt(r['last_friction_before_1'])}, "
                          f"{fmt(r['omega_1'])}], located {fmt(r.get('located_omega_1'))} (sqrt(P_l/mA) = "
                          f"{r['first_transition_paper']:.3g}, A_c onset {fmt(r['first_transition_onset'])}), regained "
-                         f"at {fmt(r['omega_2'])}, located {fmt(r.get('located_omega_2'))}" for r in diagram)
+                         f"at {fmt(r['omega_2'])}, located {fmt(r.get('located_omega_2'))}" + _theory_text(r)
+                         for r in diagram)
     measured += f" (located to {m.get('resolution', BOUNDARY_RESOLUTION):.0%} in omega)" + _ensemble_measured(m)
     if not losing:
         rows.append(Row("C6b", measured, NOT_REPRODUCED, "no row loses friction in the scanned omega range"))
@@ -254,7 +316,8 @@ def verdict_c6(m: dict) -> list[Row]:
     ratio = m["k_n_over_gamma_n"]
     recovered = [r for r in losing if r["omega_2"] is not None]
     measured = (f"k_n/gamma_n = {ratio:.3g}; omega_2 per A: "
-                + ", ".join(f"A = {r['A']:g}: {fmt(_omega_2(r))}" for r in losing))
+                + ", ".join(f"A = {r['A']:g}: {fmt(_omega_2(r))}" + _theory_text(r, recovery_only=True)
+                            for r in losing))
     if not losing:
         rows.append(Row("C6c", measured, NOT_REPRODUCED, "no sliding region to recover from"))
     elif not recovered:
@@ -287,6 +350,8 @@ def verdict_c6(m: dict) -> list[Row]:
         by_ratio.setdefault(entry["ratio"], []).append(entry)
     measured = "; ".join(f"k_n/gamma_n = {r:g}: " + ", ".join(
         f"k_n = {e['k_n']:g}: w2/(k_n/gamma_n) = {fmt(e['omega_2'] / r if e['omega_2'] else None)}"
+        + (f" (w2 = {fmt(e['omega_2'])}; theory: upper A_c root {fmt(_upper(e['theory']['A_c_roots']))}, upper A_N "
+           f"root {fmt(_upper(e['theory']['A_N_roots']))})" if e.get("theory") else "")
         for e in entries) + f" (A = {m['stiffness_amplitude']:g})" for r, entries in by_ratio.items())
     parts = []
     for r, entries in by_ratio.items():
@@ -294,7 +359,9 @@ def verdict_c6(m: dict) -> list[Row]:
         if len(found) < len(entries):
             parts.append((NOT_REPRODUCED, f"ratio {r:g}: no recovery for {len(entries) - len(found)} k_n"))
             continue
-        grid = sorted(set(round(o / r, 9) for o in entries[0]["omegas"]))
+        # The steps of every k_n's omegas at this ratio (the grid and the runs bracketing
+        # each k_n's predicted roots).
+        grid = sorted({round(o / r, 9) for e in entries for o in e["omegas"]})
         positions = [min(range(len(grid)), key=lambda i: abs(grid[i] - f)) for f in found]
         parts.append((AGREES if max(positions) - min(positions) <= 1 else DISAGREES,
                       f"ratio {r:g}: w2 spans {max(positions) - min(positions)} grid steps over k_n"))
@@ -303,7 +370,11 @@ def verdict_c6(m: dict) -> list[Row]:
 
     up, down = m["ramp_up_omega_2"], m["ramp_down_omega_2"]
     measured = (f"ramp at A = {m['ramp_amplitude']:g}, w = {m['ramp_values']}: up {m['ramp_up_regimes']}, down "
-                f"{m['ramp_down_regimes']}; friction back at w = {fmt(up)} (up), held down to {fmt(down)} (down)")
+                f"{m['ramp_down_regimes']}; friction back at w = {fmt(up)} (up), held down to {fmt(down)} (down)"
+                + (f"; theory at this A: friction lost and regained at the A_c roots "
+                   + ", ".join(f"{w:.3g}" for w in m["ramp_theory"]["A_c_roots"]) + " (applied-load bound), A_N roots "
+                   + ", ".join(f"{w:.3g}" for w in m["ramp_theory"]["A_N_roots"]) + " (contact-force bound), "
+                   f"k_n/gamma_n = {m['ramp_theory']['k_n_over_gamma_n']:.3g}" if m.get("ramp_theory") else ""))
     if up is None or "sliding" not in m["ramp_up_regimes"]:
         rows.append(Row("C6e", measured, NOT_REPRODUCED, "the up ramp shows no sliding -> friction recovery"))
     else:
