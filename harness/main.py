@@ -35,6 +35,10 @@ def main(argv: list[str] | None = None) -> Path:
     parser.add_argument("--default-reading-only", action="store_true",
                         help="measure C2 and C5-C8 under the default reading only, not under each reading of the "
                              "paper's equations (formulation x Coulomb bound)")
+    parser.add_argument("--laws", action="store_true",
+                        help="measure C2 and C5-C8 under the load-only Coulomb bound and the linear_along_normal and "
+                             "linear_no_pull contacts too (harness.paper.claims.readings.LAW_READINGS); beyond the "
+                             "default job's time budget")
     parser.add_argument("--no-progress", action="store_true")
     parser.add_argument("--report-only", action="store_true", help="redraw figures and report from <out>/claims.json")
     args = parser.parse_args(argv)
@@ -56,7 +60,8 @@ def main(argv: list[str] | None = None) -> Path:
     try:
         fmus = {m: args.fmu_dir / f"Block{m}.fmu" for m in "ABC"} if args.fmu_dir else None
         runner = Runner(out / "store", resolution, execution, client, fmus)
-        studies = run_studies(runner, progress=not args.no_progress, readings=not args.default_reading_only)
+        studies = run_studies(runner, progress=not args.no_progress, readings=not args.default_reading_only,
+                              laws=args.laws)
     except StudiesFailed as exc:
         raise SystemExit(f"python -m harness.main: {exc}") from exc
     finally:

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Sequence
 
 from .claims import CLAIMS, DEFAULT_READING, READINGS, Study, study_name
+from .claims.readings import ALL_READINGS, law_readings
 from .claims.verdicts import AGREES, DISAGREES, FLIPS, FORMULA_TOLERANCE, NOT_REPRODUCED, UNCHANGED_TOLERANCE, Row
 
 CLAIM_TEXT = {part: text for claim in CLAIMS.values() for part, text in claim.text.items()}
@@ -26,13 +27,15 @@ def _rows(name: str, study: Study) -> list[Row]:
     return made
 
 
-def reading_rows(studies: dict[str, Study]) -> dict[str, dict]:
+def reading_rows(studies: dict[str, Study], laws: bool = False, single: bool = False) -> dict[str, dict]:
     """{claim part: {reading: Row}} for every claim measured under more than one reading
-    (the readings in the claim's order, the default first)."""
+    (the readings in the claim's order, the default first); with ``laws`` the law
+    readings measured too, with ``single`` the claims measured under one reading too."""
     table: dict[str, dict] = {}
     for name, claim in CLAIMS.items():
-        present = [r for r in claim.readings if study_name(name, r) in studies]
-        if claim.verdicts is None or len(present) < 2:
+        candidates = claim.readings + (law_readings(claim.readings) if laws else ())
+        present = [r for r in candidates if study_name(name, r) in studies]
+        if claim.verdicts is None or len(present) < (1 if single else 2):
             continue
         for reading in present:
             for row in _rows(name, studies[study_name(name, reading)]):
@@ -89,9 +92,42 @@ def readings_markdown(studies: dict[str, Study]) -> list[str]:
 
 
 def _columns(table: dict) -> list:
-    """The readings present in a reading_rows table, in the order of READINGS."""
+    """The readings present in a reading_rows table, in the order of ALL_READINGS."""
     present = {r for per_part in table.values() for r in per_part}
-    return [r for r in READINGS if r in present]
+    return [r for r in ALL_READINGS if r in present]
+
+
+# The paper's Fig. 5 names the two transitions of model C that C6b and C6c check.
+FIGURE_5 = {"C6b": "Fig. 5, first transition at A = P_l/(m omega^2)",
+            "C6c": "Fig. 5, recovery near k_n/gamma_n, independent of A"}
+
+
+def reproduction_markdown(studies: dict[str, Study]) -> list[str]:
+    """Per claim part: under which readings and laws it agrees with the paper, and under
+    which it does not (with the verdict); the laws appear where they were measured
+    (``python -m harness.main --laws``)."""
+    table = reading_rows(studies, laws=True, single=True)
+    if not table:
+        return []
+    measured = _columns(table)
+    laws_measured = any(r not in READINGS for r in measured)
+    lines = ["## Which readings and laws reproduce the paper", "",
+             "Per claim part: the readings (formulation, Coulomb bound) and contact laws under which its verdict is "
+             "**agrees**, and the others with their verdicts. A part measured under the default reading only lists "
+             "that one. "
+             + ("The load-only bound and the linear_along_normal and linear_no_pull contacts were measured too "
+                "(`--laws`)." if laws_measured else
+                "The load-only bound and the linear_along_normal and linear_no_pull contacts were not measured in "
+                "this run (`python -m harness.main --laws` measures them; they do not fit the default job's time "
+                "budget)."), "",
+             "| part | reproduces the paper under | does not, under |", "|---|---|---|"]
+    for part, per_part in table.items():
+        order = [r for r in measured if r in per_part]
+        agreeing = [r.label for r in order if per_part[r].verdict == AGREES]
+        others = [f"{r.label} ({per_part[r].verdict})" for r in order if per_part[r].verdict != AGREES]
+        name = f"{part} ({FIGURE_5[part]})" if part in FIGURE_5 else part
+        lines.append(f"| {name} | {'; '.join(agreeing) or 'none'} | {'; '.join(others) or 'none'} |")
+    return lines + [""]
 
 
 def reading_summary(studies: dict[str, Study]) -> list[str]:
@@ -145,7 +181,8 @@ def markdown(studies: dict[str, Study], figures_present: Sequence[str] = (), hea
     lines += ["", "Summary: " + ", ".join(f"{v}: {n}" for v, n in sorted(summary.items()))]
     if reading_rows(studies):
         lines += ["", "Readings (see \"The readings side by side\"):"] + [f"- {line}" for line in reading_summary(studies)]
-    lines += [""] + readings_markdown(studies)
+    lines += [""] + reproduction_markdown(studies)
+    lines += readings_markdown(studies)
     described = [(name, CLAIMS[name].describe(study.measured)) for name, study in studies.items()
                  if name in CLAIMS and CLAIMS[name].describe is not None]
     if described:

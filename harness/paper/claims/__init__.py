@@ -19,7 +19,7 @@ from typing import Sequence
 
 from . import (c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery,
                c6r_recovery_question, c7_contact, c8_drive_velocity, fig1b, fig1c_paper)
-from .readings import DEFAULT_READING, READINGS, Reading, split_study_name, study_name
+from .readings import DEFAULT_READING, READINGS, Reading, law_readings, split_study_name, study_name
 from .measure import friction_held, onset_amplitude, recovery, stable_roots_near, transition_bracket
 from .study import RESOLUTIONS, Claim, Resolution, Runner, Study, counts, load_studies, save_studies, timing
 
@@ -48,16 +48,18 @@ def priority(name: str) -> int:
 
 
 def run_studies(runner: Runner, names: Sequence[str] = tuple(CLAIMS), progress: bool = True,
-                readings: bool = True, at_once: int | None = None) -> dict[str, Study]:
+                readings: bool = True, at_once: int | None = None, laws: bool = False) -> dict[str, Study]:
     """Run the named studies, each under every reading its claim lists (only the default
-    one if ``readings`` is false or the resolution measures the default reading only);
+    one if ``readings`` is false or the resolution measures the default reading only),
+    and with ``laws`` under the claim's law readings too (:func:`.readings.law_readings`);
     {study name: Study} (:func:`.readings.study_name`) in that order, each with its
     timing.  Up to ``at_once`` studies run side by side (default: all of them on a Dask
     client, with :func:`priority`; one at a time inline), each on a runner of its own
     (:meth:`Runner.for_reading`); their counts are added to ``runner``'s."""
     readings = readings and runner.resolution.readings
     jobs = [(name, reading) for name in names
-            for reading in (CLAIMS[name].readings if readings else (DEFAULT_READING,))]
+            for reading in ((CLAIMS[name].readings + (law_readings(CLAIMS[name].readings) if laws else ()))
+                            if readings else (DEFAULT_READING,))]
     at_once = max(1, at_once or (len(jobs) if runner.client is not None else 1))
     bar = None
     if progress:
