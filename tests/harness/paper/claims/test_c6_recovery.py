@@ -198,3 +198,28 @@ def test_the_figures_for_the_papers_figs_5_and_6_say_they_run_the_scaled_drive_a
     assert any("A_c" in label for label in diagram) and any("A_N" in label for label in diagram)
     assert "Fig. 5" in titles["model_c_phase_diagram.png"] and "Fig. 6" in titles["omega2_vs_k_n.png"]
     assert all("scaled drive" in title and "fig5_paper" in title for title in titles.values())
+
+
+def test_the_rows_bracket_the_roots_linear_theory_predicts():
+    """The predicted roots solve A_c(omega) = A and A_N(omega) = A of the closed forms
+    (harness.paper.analytic, independent of vibroblock.orbits), and the extra omegas put
+    each between two runs."""
+    from harness.paper.analytic import detachment_amplitude, friction_loss_amplitude
+    from harness.paper.claims.c6_recovery import BRACKET, theory_roots
+
+    for amplitude in (0.3, 1.0, 3.0, 10.0):
+        theory = theory_roots(amplitude)
+        assert theory["paper_omega_1"] == pytest.approx((1.0 / amplitude) ** 0.5)
+        for root in theory["A_c_roots"]:
+            assert detachment_amplitude(root) == pytest.approx(amplitude, rel=1e-3)
+        for root in theory["A_N_roots"]:
+            assert friction_loss_amplitude(root) == pytest.approx(amplitude, rel=1e-3)
+        for root in [theory["paper_omega_1"], *theory["A_c_roots"], *theory["A_N_roots"]]:
+            assert any(w < root for w in theory["bracketed"]) and any(w > root for w in theory["bracketed"])
+            assert min(abs(w / root - BRACKET) for w in theory["bracketed"]) < 1e-3
+    # Below delta_0 friction is lost in a band only: two roots, the upper one its recovery.
+    assert len(theory_roots(0.3)["A_c_roots"]) == 2 and len(theory_roots(3.0)["A_c_roots"]) == 1
+    # The figures of the brief: sqrt(P_l/(m A)) against the A_c root, 107 % at A = 0.3 and 5 % at 10.
+    for amplitude, gap in ((0.3, 1.07), (10.0, 0.05)):
+        theory = theory_roots(amplitude)
+        assert theory["paper_omega_1"] / theory["A_c_roots"][0] - 1 == pytest.approx(gap, abs=0.02)

@@ -55,3 +55,21 @@ def test_the_figure_for_the_papers_fig_7_says_which_drive_and_amplitude_it_runs(
     c8_drive_velocity.draw(study, lambda figure, name: titles.setdefault(name, figure.axes[0].get_title()))
     assert "Fig. 7" in titles["model_c_Vd_omega.png"] and "A = 0.5" in titles["model_c_Vd_omega.png"]
     assert "scaled" in titles["model_c_Vd_omega.png"] and "2e4" in titles["model_c_Vd_omega.png"]
+
+
+def test_model_c_at_the_largest_v_d_is_judged_by_adaptive_where_its_tolerances_agree():
+    def values(decided):
+        return {"omegas": [0.3, 3.0], "model_a": [{"V_d": 10.0, "regimes": ["sliding", "sliding"]}],
+                "model_c": [{"V_d": 10.0, "regimes": ["hopping", "hopping"]}], "model_a_amplitude": 2.0,
+                "model_c_amplitude": 0.5,
+                "model_c_decided": {"V_d": 10.0, "tolerances": [{"rtol": 1e-6}, {"rtol": 1e-8}], "omegas": decided},
+                "offsets": [{"V_d": 10.0, "x0": 30.0, "x0_std": 0.1, "force_balance": 30.0, "paper": -20.0,
+                             "regime": "sliding"}]}
+    sliding = [{"omega": w, "adaptive": ["sliding", "sliding"], "paper_scheme": "hopping", "regime": "sliding"}
+               for w in (0.3, 3.0)]
+    row, _ = verdict_c8(values(sliding))
+    assert row.verdict == AGREES and "symplectic_euler hopping" in row.measured
+    unresolved = [sliding[0], {"omega": 3.0, "adaptive": ["sliding", "stick_slip"], "paper_scheme": "hopping",
+                               "regime": "unresolved"}]
+    row, _ = verdict_c8(values(unresolved))
+    assert row.verdict == NOT_REPRODUCED and "w = 3 (unresolved)" in row.reason
