@@ -39,6 +39,9 @@ def main(argv: list[str] | None = None) -> Path:
                         help="measure C2 and C5-C8 under the load-only Coulomb bound and the linear_along_normal and "
                              "linear_no_pull contacts too (harness.paper.claims.readings.LAW_READINGS); beyond the "
                              "default job's time budget")
+    parser.add_argument("--ensembles-every-reading", action="store_true",
+                        help="run C6's start-phase ensemble under every reading, not only the default one (beyond "
+                             "the default job's time budget)")
     parser.add_argument("--no-progress", action="store_true")
     parser.add_argument("--report-only", action="store_true", help="redraw figures and report from <out>/claims.json")
     args = parser.parse_args(argv)
@@ -60,6 +63,7 @@ def main(argv: list[str] | None = None) -> Path:
     try:
         fmus = {m: args.fmu_dir / f"Block{m}.fmu" for m in "ABC"} if args.fmu_dir else None
         runner = Runner(out / "store", resolution, execution, client, fmus)
+        runner.ensembles_every_reading = args.ensembles_every_reading
         studies = run_studies(runner, progress=not args.no_progress, readings=not args.default_reading_only,
                               laws=args.laws)
     except StudiesFailed as exc:

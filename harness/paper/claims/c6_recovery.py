@@ -13,7 +13,9 @@ A").  C6d: at each k_n/gamma_n, omega_2 (in units of k_n/gamma_n) spreads over a
 one grid step across k_n.  C6e: up and down ramps regain friction at the same omega.
 
 Start phases and horizon: the diagram's points start on a crest and their window sees a
-quarter of a corrugation wavelength of drive travel.  In the default reading, both sides
+quarter of a corrugation wavelength of drive travel.  In the default reading (in every
+reading with ``Runner.ensembles_every_reading``, ``python -m harness.main
+--ensembles-every-reading``), both sides
 of the located omega_1 and omega_2 of the lowest A row are run again from four start
 phases (crest, descending flank, valley, ascending flank) over
 ``Resolution.ensemble_wavelengths`` wavelengths (3 by default); where a side's class
@@ -90,10 +92,11 @@ def study_c6(runner: Runner) -> Study:
                      "first_transition_paper": math.sqrt(1.0 / float(amplitude)),
                      "first_transition_onset": onset_omega(float(amplitude), 0.07), "theory": theory})
     _locate_transitions(runner, base, rows)
-    # Every reading: a boundary that depends on the start is no property of the model in
-    # any reading.
+    # A boundary that depends on the start is no property of the model in any reading; the
+    # other readings' ensembles run on request (Runner.ensembles_every_reading).
     ensemble = (_check_by_start_ensemble(runner, rows, res.ensemble_wavelengths)
-                if res.ensemble_wavelengths > 0 else None)
+                if res.ensemble_wavelengths > 0
+                and (runner.reading == DEFAULT_READING or runner.ensembles_every_reading) else None)
 
     stiffness_amplitude = 0.5
     base_k = PointSettings(run=c_run(runner, res.c_horizon, A=stiffness_amplitude), observe=observe_c)

@@ -154,6 +154,10 @@ class Runner:
         # studies side by side, a study's own cost (its wall time overlaps the others').
         self.compute_time = 0.0
         self.reading: Reading = DEFAULT_READING
+        # C6's start ensemble under every reading, not only the default one: each costs
+        # 16 runs of 3.5 corrugation wavelengths (~11 diagram points each), beyond the
+        # main job's 20-minute budget under the other three readings.
+        self.ensembles_every_reading = False
 
     def run(self, model: str, **fields) -> RunSettings:
         """A run of ``model`` under the runner's reading (parameters the study sets win).

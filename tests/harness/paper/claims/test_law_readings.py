@@ -80,3 +80,9 @@ def test_the_reproduction_table_names_where_each_part_agrees():
 
 def test_fig_5_s_transitions_are_named_in_the_table():
     assert "P_l/(m omega^2)" in report.FIGURE_5["C6b"] and "k_n/gamma_n" in report.FIGURE_5["C6c"]
+
+
+def test_c6_ensembles_under_other_readings_run_on_request_only(runner):
+    assert runner.ensembles_every_reading is False
+    runner.ensembles_every_reading = True
+    assert runner.for_reading(READINGS[2]).ensembles_every_reading is True
