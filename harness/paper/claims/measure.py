@@ -342,15 +342,25 @@ def foot_bracket(curve: dict, start: float, upward: bool, threshold: float) -> t
     """The crossover's foot on the measured curve {value: observables}: walking from
     ``start`` (the sliding side of the located threshold crossing) away from the held side
     (towards higher values if ``upward``), the first pair of neighbours whose phi falls
-    from above the floor to the floor (ascending (lo, hi)); None if the curve never
-    reaches the floor there."""
+    from above the floor to the floor (ascending (lo, hi)); None if the curve does not
+    reach the floor there before the block leaves the plate.  A crossover is a change in
+    contact: the walk ends after the first run that loses contact (where phi may reach the
+    floor with the contact force reaching 0, at A_N), or the foot would be located where
+    the block flies, far from the crossover."""
     values = sorted(v for v in curve if (v >= start if upward else v <= start))
     if not upward:
         values = values[::-1]
     for near, far in zip(values[:-1], values[1:]):
+        if not _in_contact(curve[near]):
+            return None
         if above_floor(curve[near], threshold) and not above_floor(curve[far], threshold):
             return (near, far) if upward else (far, near)
     return None
+
+
+def _in_contact(observables: dict) -> bool:
+    contact = _finite_phi(observables.get("contact_fraction"))
+    return contact is not None and contact >= IN_CONTACT
 
 
 def locate_feet(measure, searches: list[dict], threshold: float, resolution: float) -> None:

@@ -60,6 +60,17 @@ def test_the_foot_is_bisected_to_where_phi_reaches_the_floor():
     assert foot_bracket({0.5: side(50.0), 0.7: side(20.0)}, 0.5, True, THRESHOLD) is None
 
 
+def test_the_foot_is_not_sought_past_a_run_that_leaves_the_plate():
+    """Walking up a crossover, a run that loses contact ends the walk: phi's floor beyond
+    it (a flying block) is not the crossover's foot, but the floor reached as the block
+    starts to leave the plate is."""
+    bouncing = {"phi": 30.0, "contact_fraction": 0.4}
+    curve = {0.5: side(50.0), 0.7: side(20.0), 1.0: bouncing, 60.0: side(0.0)}
+    assert foot_bracket(curve, 0.5, True, THRESHOLD) is None
+    curve[0.8] = side(0.0, contact=0.9)
+    assert foot_bracket(curve, 0.5, True, THRESHOLD) == (0.7, 0.8)
+
+
 @pytest.mark.slow
 def test_model_a_loses_friction_in_a_crossover_ending_at_the_closed_form_a_n(tmp_path, fmu_dir):
     """Model A at omega = 2.52 under the contact-force bound: phi falls continuously as A
