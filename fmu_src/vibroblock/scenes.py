@@ -174,6 +174,11 @@ def _end_normal(kind, rigid, x, z, vx, vz, pz, pv, step_normal, prm):
     return contact(kind, x, z, vx, vz, pz, pv, prm)[5]
 
 
+# Called by the driver's loop, not inlined into it (``fixed_step.register``): its rigid contact and impacts cost
+# far more than the call, and inlined they doubled the loop's compile time.
+INLINE_STEP = False
+
+
 @njit(inline="always")
 def prepare(kind, flags, drv, prm, h):
     """The frozen orbit's complex amplitude (``orbit_response``)."""

@@ -232,7 +232,7 @@ def _entry_point(kernel, kind: int, method: int, args: tuple):
 
 
 def _fixed_step(id, name, module, **record):
-    fixed_step.SCHEMES[id] = (module.prepare, module.step)
+    fixed_step.register(id, module.prepare, module.step, getattr(module, "INLINE_STEP", True))
     return Integrator(id=id, name=name, advance=fixed_step.advance, observe=fixed_step.observe,
                       scheme=(module.prepare, module.step), **record)
 
@@ -325,7 +325,7 @@ def _register_reduced_scene() -> Integrator:
     record = Integrator(scenes.SCHEME_ID, "reduced_scene", "scene reductions, first order", models="*",
                         force_evaluations=1, check_step=_no_limit, advance=fixed_step.advance,
                         observe=scenes.observe, public=False, scheme=(scenes.prepare, scenes.step))
-    fixed_step.SCHEMES[scenes.SCHEME_ID] = record.scheme
+    fixed_step.register(scenes.SCHEME_ID, scenes.prepare, scenes.step, scenes.INLINE_STEP)
     BY_ID[scenes.SCHEME_ID] = record
     return record
 

@@ -576,6 +576,11 @@ def implicit_contact_step(kind, prm, state, t, h, plate, ctx, track_energy):
 
 
 # ---------------------------------------------------------------------- the scheme
+# Called by the driver's loop, not inlined into it (``fixed_step.register``): its closed-form flows cost
+# far more than the call, and inlined they doubled the loop's compile time.
+INLINE_STEP = False
+
+
 @njit(inline="always")
 def prepare(kind, flags, drv, prm, h):
     """The step's propagators and the scratch arrays for the contact segments of a step."""

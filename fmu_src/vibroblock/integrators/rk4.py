@@ -13,6 +13,11 @@ from ..dynamics import contact, energy_rates, force, position_rates
 from ..layout import P_M, P_VD
 
 
+# Called by the driver's loop, not inlined into it (``fixed_step.register``): four stages cost
+# far more than the call, and inlined they doubled the loop's compile time.
+INLINE_STEP = False
+
+
 @njit(inline="always")
 def prepare(kind, flags, drv, prm, h):
     return 0

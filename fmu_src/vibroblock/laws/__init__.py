@@ -155,7 +155,7 @@ def _dispatch(axis_name: str, function: str, arguments: str):
     takes_kind = arguments.startswith("kind,")
     return by_kind({law.id: getattr(law.module, function) for law in laws.values()},
                    f"(kind >> {axis.shift}) & {(1 << axis.width) - 1}",
-                   arguments[len("kind, "):] if takes_kind else arguments, takes_kind)
+                   arguments[len("kind, "):] if takes_kind else arguments, takes_kind, inline_default_only=True)
 
 
 def _constant(axis_name: str, attribute: str):

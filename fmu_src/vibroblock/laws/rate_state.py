@@ -167,8 +167,12 @@ def rule_with(evolve):
     """The friction rule (``laws``: friction) of a rate-and-state law whose theta evolves
     over a step by the compiled ``evolve(theta, V, h, prm)``: the interface's slip over
     the step, then theta's evolution at its rate.  The rule returns (F, theta, False):
-    rate-and-state friction has no reset."""
-    @njit(inline="always")
+    rate-and-state friction has no reset.
+
+    Compiled once and called: inlined, its Newton solve went into every kernel that
+    dispatches on the friction law, whichever law runs, and cost seconds of compile time
+    in each; called, it costs a call per step where rate-and-state friction runs."""
+    @njit
     def rule(shear, theta, penetration, bound_normal, slip_rate, h, prm):
         shear, rate = interface_slip(shear, theta, penetration, bound_normal, h, prm)
         if rate < 0.0:  # no contact: theta kept
