@@ -72,6 +72,8 @@ for _prefix, _uri in NS.items():
     ET.register_namespace(_prefix, _uri)
 FMU_TYPE = "application/x-fmu-sharedlibrary"
 PLATE_CONNECTIONS = (("plate_z", "plate_z"), ("plate_v", "plate_v"), ("plate_a", "plate_a"))
+# A block on an oblique plate (plate_motion = 1) also takes the motion along x.
+HORIZONTAL_CONNECTIONS = (("plate_x", "plate_x"), ("plate_vx", "plate_vx"), ("plate_ax", "plate_ax"))
 BLOCK_OUTPUTS = ("x", "z", "vx", "vz", "phi_integral", "coulomb_resets", "contact", "normal_force")
 
 
@@ -113,12 +115,16 @@ class System:
 def excitation_block_system(excitation_fmu: str | os.PathLike, block_fmu: str | os.PathLike, *,
                             excitation: Mapping[str, Value] | None = None, block: Mapping[str, Value] | None = None,
                             block_outputs: Sequence[str] = BLOCK_OUTPUTS, name: str = "plate_and_block") -> System:
-    """The Excitation FMU driving a Block FMU: plate_z, plate_v, plate_a connected one to one."""
+    """The Excitation FMU driving a Block FMU: plate_z, plate_v, plate_a connected one to one,
+    and plate_x, plate_vx, plate_ax too where the block runs the oblique plate
+    (``plate_motion`` 1 or "oblique" among its values)."""
+    block = dict(block or {})
+    pairs = PLATE_CONNECTIONS + (HORIZONTAL_CONNECTIONS if block.get("plate_motion") in (1, "oblique") else ())
     return System(
         name=name,
         components=(Component("plate", str(excitation_fmu), dict(excitation or {})),
-                    Component("block", str(block_fmu), dict(block or {}), tuple(block_outputs))),
-        connections=tuple(("plate", out, "block", inp) for out, inp in PLATE_CONNECTIONS))
+                    Component("block", str(block_fmu), block, tuple(block_outputs))),
+        connections=tuple(("plate", out, "block", inp) for out, inp in pairs))
 
 
 # ---------------------------------------------------------------------------- writing

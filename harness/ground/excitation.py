@@ -191,7 +191,8 @@ def plate_input(source, *, step_size: float | None = None, stop_time: float | No
     ``horizontal``: a second motion (of the same kinds as ``source``, played with the
     same scales and parameters) for the plate's horizontal inputs ``plate_x, plate_vx,
     plate_ax`` of a block with ``plate_motion = 1`` (oblique), e.g. the horizontal
-    component of a three-component record (``records.load_ground_motion_components``).
+    component of a three-component record (``records.load_ground_motion_components``);
+    or True: the source's own motion along x (an Excitation's ``direction``).
     """
     if step_size is None:
         if not isinstance(source, PlateDrive) or parameters or scales is not None or horizontal is not None:
@@ -208,7 +209,9 @@ def plate_input(source, *, step_size: float | None = None, stop_time: float | No
                 (p["onset"] + record.duration * p["time_scale"] - start_time) / step_size + 1e-9)
         times = communication_times(stop_time, step_size, start_time)
         columns = (times, *excitation.evaluate(times))
-        if horizontal is not None:
+        if horizontal is True:  # the source's own motion along x (a direction, a record's horizontal component)
+            columns += tuple(excitation.evaluate_horizontal(times))
+        elif horizontal is not None:
             columns += tuple(excitation_of(horizontal, scales, **parameters).evaluate(times))
     names = INPUT_NAMES + (HORIZONTAL_INPUT_NAMES if len(columns) > 4 else ())
     table = np.empty(len(columns[0]), dtype=[("time", float)] + [(name, float) for name in names])
