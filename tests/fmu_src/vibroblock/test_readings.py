@@ -85,7 +85,7 @@ def test_bad_readings_are_refused_with_what_is_allowed():
     with pytest.raises(ModelError, match="scene reductions"):
         Block("B", rigid_contact=True, coulomb_normal=1).start()
     assert Block("C", formulation="tangent_frame", coulomb_normal="applied_load").readings == {
-        "formulation": 1, "coulomb_normal": 1, "flight": 0, "contact_law": 0, "friction_law": 0}
+        "formulation": 1, "coulomb_normal": 1, "flight": 0, "contact_law": 0, "friction_law": 0, "plate_motion": 0}
 
 
 # ---------------------------------------------------------------- statics
@@ -213,7 +213,7 @@ def test_saved_state_continues_bit_for_bit(combination):
     expected = block.outputs()
     again = Block("C", "rk4", **SCALED)
     again.set_state(state)
-    assert again.readings == {**options(combination), "contact_law": 0, "friction_law": 0}
+    assert again.readings == {**options(combination), "contact_law": 0, "friction_law": 0, "plate_motion": 0}
     again.advance_to(20.0)
     assert again.outputs() == expected
 
