@@ -17,3 +17,8 @@ def test_this_build_runs_the_release_s_fixed_axes_contact_and_both_the_same_tole
     ours, theirs = request(scenario, 1e-6, True), request(scenario, 1e-6, False)
     assert ours["parameters"].pop("contact_law") == 1 and "contact_law" not in theirs["parameters"]
     assert ours == theirs and ours["parameters"]["atol"] == 1e-8
+
+
+def test_the_tangent_frame_runs_the_default_contact_which_is_the_release_s_there():
+    scenario = next(s for s in SCENARIOS if s.formulation == 1)
+    assert "contact_law" not in request(scenario, 1e-6, True)["parameters"]
