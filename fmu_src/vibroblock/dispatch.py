@@ -17,7 +17,7 @@ def by_kind(functions: dict, selector: str, arguments: str, takes_kind: bool = F
     ``"(kind >> 6) & 3"``) to a compiled function; ``arguments`` names their arguments
     (``takes_kind``: the functions take ``kind`` first themselves).  With
     ``inline_default_only`` only the branch of value 0 (a law axis' default) is inlined;
-    the others are called, each compiled once as a function of its own (``_called``)."""
+    the others are called, each compiled once as a function of its own (``called``)."""
     # Values sharing one function (e.g. every friction law's spring force) share one branch:
     # each branch is inlined at every call site, and LLVM's time grows with the inlined size.
     groups: dict[int, list[int]] = {}
@@ -29,7 +29,7 @@ def by_kind(functions: dict, selector: str, arguments: str, takes_kind: bool = F
     if inline_default_only:
         for values in branches:
             if 0 not in values:
-                namespace[f"_{values[0]}"] = _called(functions[values[0]], passed)
+                namespace[f"_{values[0]}"] = called(functions[values[0]], passed)
     lines = [f"def dispatch(kind, {arguments}):"]
     if len(branches) == 1:
         lines.append(f"    return _{branches[0][0]}({passed})")
@@ -50,9 +50,10 @@ def by_kind(functions: dict, selector: str, arguments: str, takes_kind: bool = F
     return njit(inline="always")(namespace["dispatch"])
 
 
-def _called(function, arguments: str):
-    """``function`` (inlined where it is called) wrapped in a function that is compiled
-    once per signature and called: a law other than an axis' default costs a call where
+def called(function, arguments: str):
+    """``function`` (inlined where it is called) wrapped in a function of ``arguments``
+    that is compiled once per signature and called: a law other than an axis' default
+    (and a fixed-step scheme's heavier step, ``fixed_step.register``) costs a call where
     it runs, and every kernel that dispatches on the axis stays small for LLVM, whose
     time grows faster than the inlined size (inlined, every law of every axis went into
     every fixed-step loop and doubled its compile time)."""

@@ -23,14 +23,12 @@ is that they stay within 10 %, i.e. a ratio >= 0.9.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
-import subprocess
 import sys
 from pathlib import Path
 
-from harness.benchmarks.build_cost import PREVIOUS, _child_env, previous_core
+from harness.benchmarks.build_cost import PREVIOUS, SpeedChild, previous_core
 from harness.benchmarks.work_precision import ACCURACY, ADAPTIVE_DT, RTOLS, SCENARIOS, accuracy, errors
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -56,27 +54,6 @@ for line in sys.stdin:
     out = block.outputs()
     print(json.dumps([seconds, {"x": out["x"], "z": out["z"], "phi": out["phi_integral"]}]), flush=True)
 """
-
-
-class Core:
-    """A process running one core's ``adaptive`` on the runs it is sent."""
-
-    def __init__(self, core_parent: Path, cache: Path):
-        self.process = subprocess.Popen([sys.executable, "-c", RUN], env=_child_env(cache, core_parent),
-                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-
-    def run(self, request: dict) -> tuple[float, dict]:
-        self.process.stdin.write(json.dumps(request) + "\n")
-        self.process.stdin.flush()
-        line = self.process.stdout.readline()
-        if not line:
-            raise RuntimeError(f"the core at {request} stopped")
-        seconds, obs = json.loads(line)
-        return seconds, obs
-
-    def close(self) -> None:
-        self.process.stdin.close()
-        self.process.wait()
 
 
 def request(scenario, rtol: float, release_contact: bool) -> dict:
@@ -111,8 +88,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     scenarios = [s for s in SCENARIOS if s.model != "A" and s.name.startswith(args.only)]
     work = ROOT / "build" / "work"
-    this = Core(CORE_PARENT, Path(os.environ.get("NUMBA_CACHE_DIR", work / "numba")))
-    previous = Core(previous_core(args.previous), work / f"numba-release-{args.previous}")
+    this = SpeedChild(CORE_PARENT, Path(os.environ.get("NUMBA_CACHE_DIR", work / "numba")), RUN)
+    previous = SpeedChild(previous_core(args.previous), work / f"numba-release-{args.previous}", RUN)
     print(f"adaptive on B and C, this build against the release {args.previous}: CPU seconds, best of "
           f"{args.rounds} in turns; error against scipy DOP853 at 1e-12 (largest of x, phi relative, z in "
           f"delta_0); ratio = previous / this (target at equal accuracy {ACCURACY:g}: >= {TARGET})")
@@ -127,7 +104,7 @@ def main(argv=None) -> int:
                 for _ in range(args.rounds):
                     for side, core, ask in (("previous", previous, request(scenario, rtol, False)),
                                             ("this", this, request(scenario, rtol, True))):
-                        seconds, obs = core.run(ask)
+                        seconds, obs = core.seconds(ask)
                         if seconds < best[side][0]:
                             best[side] = (seconds, obs)
                 cells = []

@@ -261,10 +261,11 @@ def previous_core(commit: str) -> Path:
 
 
 class SpeedChild:
-    """A process running one core's kernels on the scenarios it is sent, one at a time."""
+    """A process running one core's kernels on the scenarios it is sent, one at a time:
+    ``script`` reads a JSON line per scenario and answers with one."""
 
-    def __init__(self, core_parent: Path, cache: Path):
-        self.process = subprocess.Popen([sys.executable, "-c", SPEED], env=_child_env(cache, core_parent),
+    def __init__(self, core_parent: Path, cache: Path, script: str = SPEED):
+        self.process = subprocess.Popen([sys.executable, "-c", script], env=_child_env(cache, core_parent),
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
     def seconds(self, scenario) -> tuple[float, float]:

@@ -34,6 +34,7 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import literally, njit, types
 from numba.extending import overload
 
+from ..dispatch import called
 from ..dynamics import contact, coulomb_bound, friction_rule
 from ..laws import friction_released, friction_spring_force, plate_moves_sideways
 from ..unowned import data_pointer
@@ -61,11 +62,7 @@ def register(method: int, prepare, step, inline_step: bool = True) -> None:
     into the loop (no call per step: a model-A Euler step costs 15 % less), else called
     (a heavier step, whose call costs little against it, compiled once: inlined into the
     loop LLVM's time roughly doubles, and a first use would exceed its 30 s budget)."""
-    if not inline_step:
-        namespace = {"step": step}
-        exec(f"def called({STEP_ARGUMENTS}):\n    return step({STEP_ARGUMENTS})", namespace)  # noqa: S102
-        step = njit(namespace["called"])
-    SCHEMES[method] = (prepare, step)
+    SCHEMES[method] = (prepare, step if inline_step else called(step, STEP_ARGUMENTS))
 
 
 def scheme_prepare(method, kind, flags, drv, prm, h):
