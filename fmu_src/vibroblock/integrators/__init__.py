@@ -51,7 +51,7 @@ from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import typeof, types  # noqa: E402
 
 from . import adaptive, event_driven, fixed_step, implicit_contact, rk4, symplectic_euler
-from ..laws import law
+from ..laws import AXES, law
 from ..orbits import orbit_response
 from .fixed_step import NON_FINITE, OK, STOP
 
@@ -252,7 +252,8 @@ _ADAPTIVE_STATUSES = {
     adaptive.STEP_TOO_SMALL: (
         "the error-controlled step fell to rounding level between t = {t:g} and t = {t_end:g} ({integrator}): "
         "the tolerances cannot be met there; the state at t = {t:g} is kept. Loosen rtol/atol or check the "
-        "parameters for extreme values."),
+        "parameters for extreme values. Under rate-and-state friction this is where the interface's slip runs "
+        "away in finite time, k_t < (b - a) N_b / D_c (docs/physics.md, Sec. 5)."),
     adaptive.TOO_MANY_STEPS: (
         f"more than {adaptive.MAX_STEPS} internal steps between t = {{t:g}} and t = {{t_end:g}} ({{integrator}}; "
         "some 20 s of work): a master must not be held that long; the state at t = {t:g} is kept. Use "
@@ -307,10 +308,16 @@ def _exact_flows(model: str, readings: dict, parameters: dict) -> Integrator | N
     the reading (the applied-load bound) or the parameters (an undamped contact driven at
     resonance), adaptive keeps its own steps."""
     exact = INTEGRATOR_RECORDS["event_driven"]
-    if (not exact.supports(model) or exact.unsupported_reading(readings)
+    if (not exact.supports(model) or exact.unsupported_reading(readings) or _refused_by_a_law(exact, readings)
             or exact.check_step(parameters, model, exact.name)):
         return None
     return _ADAPTIVE_EXACT
+
+
+def _refused_by_a_law(record: Integrator, readings: dict) -> bool:
+    """Whether one of the run's laws refuses ``record`` (e.g. rate-and-state friction, whose
+    interface event_driven's closed forms do not follow: adaptive keeps its own steps)."""
+    return any(record.name in law(axis.name, readings.get(axis.parameter, 0)).refused_by for axis in AXES.values())
 
 
 BY_ID: dict[int, Integrator] = {r.id: r for r in _RECORDS}

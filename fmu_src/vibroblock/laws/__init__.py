@@ -27,7 +27,12 @@ friction      ``friction_law``  spring_force(F, prm), energy(F, prm), released(F
                                 the rule at the end of a step of length h, ``state``
                                 the law's state (``layout.Y_FRICTION_STATE``), u_t the
                                 slip rate there; in Python: initial_state(parameters),
-                                the state at the start (absent: 0)
+                                the state at the start (absent: 0); in continuous time,
+                                interface(F, s, N_b, prm) -> (the interface's slip rate
+                                along F, ds/dt) for the integrated variable s =
+                                integrated(state) (state = stored(s)), and INTERFACE_SLIPS
+                                (False: the interface sticks between resets, no state to
+                                integrate)
 bound         ``coulomb_normal``  normal(kind, N, x, t, prm): the N of the bound mu_s N
 plate         ``plate_motion``  motion(A, omega, sin, cos, ext_z, ext_v, ext_a, tau),
                                 acceleration(A, omega, sin, ext_a) (the vertical motion,
@@ -178,6 +183,10 @@ contact_conservative = _constant("contact", "CONSERVATIVE")
 friction_spring_force = _dispatch("friction", "spring_force", "shear, prm")
 friction_energy = _dispatch("friction", "energy", "shear, prm")
 friction_released = _dispatch("friction", "released", "before, after, prm")
+friction_interface = _dispatch("friction", "interface", "shear, state, bound_normal, prm")
+friction_interface_slips = _constant("friction", "INTERFACE_SLIPS")
+friction_integrated = _dispatch("friction", "integrated", "state")
+friction_stored = _dispatch("friction", "stored", "value")
 friction_rule = _dispatch("friction", "rule", "shear, state, penetration, bound_normal, slip_rate, h, prm")
 bound_normal = _dispatch("bound", "normal", "kind, contact_normal, x, t, prm")
 plate_motion = _dispatch("plate", "motion", "amp, omega, sin_phase, cos_phase, ext_z, ext_v, ext_a, tau")

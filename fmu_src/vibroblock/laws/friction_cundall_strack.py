@@ -10,6 +10,9 @@ from numba import njit
 from ..layout import P_KT, P_MUS
 
 ID = 0
+# The spring sticks to the plate until its reset: no slip of the interface between resets
+# (``interface``), so an error-controlled integrator carries no state of the law.
+INTERFACE_SLIPS = False
 
 
 @njit(inline="always")
@@ -41,3 +44,21 @@ def rule(shear, state, penetration, bound_normal, slip_rate, h, prm):
     if abs(prm[P_KT] * shear) >= prm[P_MUS] * bound_normal:
         return 0.0, 0.0, shear != 0.0
     return shear, 0.0, False
+
+
+@njit(inline="always")
+def integrated(state):
+    """The variable an error-controlled integrator carries for the law's state: itself."""
+    return state
+
+
+@njit(inline="always")
+def stored(value):
+    return value
+
+
+@njit(inline="always")
+def interface(shear, state, bound_normal, prm):
+    """The interface's slip rate along F and the rate of the law's state, in continuous
+    time (error-controlled integrators): none, the spring holds until the rule resets it."""
+    return 0.0, 0.0

@@ -29,7 +29,8 @@ from numba import njit
 
 from ..layout import P_KT, P_MUS, slot
 from ..parameters import NON_NEGATIVE, Parameter
-from .friction_cundall_strack import energy, released, spring_force  # noqa: F401  (the same spring)
+from .friction_cundall_strack import (INTERFACE_SLIPS, energy, integrated, interface, released,  # noqa: F401
+                                      spring_force, stored)  # (the same spring, sticking between its resets)
 
 ID = 2
 PARAMETERS = (

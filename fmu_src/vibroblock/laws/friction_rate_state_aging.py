@@ -11,7 +11,8 @@ import math
 from numba import njit
 
 from .friction_cundall_strack import energy, released, spring_force  # noqa: F401  (the same spring)
-from .rate_state import P_DC, PARAMETERS, REFUSED_BY, initial_state, rule_with, relative_expm1  # noqa: F401
+from .rate_state import (INTERFACE_SLIPS, P_DC, PARAMETERS, REFUSED_BY, initial_state, integrated,  # noqa: F401
+                         interface_with, relative_expm1, rule_with, stored)
 
 ID = 3
 
@@ -23,4 +24,11 @@ def evolve(theta, slip_rate, h, prm):
     return theta * math.exp(-x) + h * relative_expm1(x)
 
 
+@njit(inline="always")
+def log_state_rate(log_theta, slip_rate, prm):
+    """d(ln theta)/dt = 1 / theta - V / D_c."""
+    return math.exp(-log_theta) - slip_rate / prm[P_DC]
+
+
 rule = rule_with(evolve)
+interface = interface_with(log_state_rate)

@@ -11,7 +11,8 @@ import math
 from numba import njit
 
 from .friction_cundall_strack import energy, released, spring_force  # noqa: F401  (the same spring)
-from .rate_state import P_DC, PARAMETERS, REFUSED_BY, initial_state, rule_with  # noqa: F401
+from .rate_state import (INTERFACE_SLIPS, P_DC, PARAMETERS, REFUSED_BY, initial_state, integrated,  # noqa: F401
+                         interface_with, rule_with, stored)
 
 ID = 4
 
@@ -25,4 +26,13 @@ def evolve(theta, slip_rate, h, prm):
     return theta * math.exp(math.log(slip_rate * theta / prm[P_DC]) * math.expm1(-x))
 
 
+@njit(inline="always")
+def log_state_rate(log_theta, slip_rate, prm):
+    """d(ln theta)/dt = -(V / D_c) ln(V theta / D_c); 0 at V = 0 (V ln V -> 0)."""
+    if slip_rate <= 0.0:
+        return 0.0
+    return -(slip_rate / prm[P_DC]) * (math.log(slip_rate / prm[P_DC]) + log_theta)
+
+
 rule = rule_with(evolve)
+interface = interface_with(log_state_rate)

@@ -26,6 +26,14 @@ the law is at small V (exp(Psi/a) ~ 1e26 at the defaults); it is solved in logar
 (``relaxed``), where V cannot overflow.  Then theta evolves over h at the slip rate V(F_1), exactly for a rate
 held over the step (the law module's ``evolve``).  First order in h overall.
 
+An error-controlled integrator (``adaptive``) takes the same law in continuous time
+instead (``interface_with``): F and ln theta are state components with
+dF/dt = u_t - sign(F) V(F) and theta's law, so its tolerance, not a first-order rule,
+sets the error.  It integrates ln theta, not theta: theta relaxes to D_c / V at the rate
+V / D_c, thousands per tau_0 in a fast slip, and a stiff-stable step's stages may
+overshoot a positive quantity below zero, where ln theta has no such edge (and its
+error weight is theta's relative error, which is what mu sees).
+
 In the limit k_t -> infinity the block itself slips at V: the classical
 spring-slider.  With a finite k_t the loading stiffness Ruina's stability threshold
 k_c = (b - a) N / D_c compares with is the drive spring in series with the contact's,
@@ -56,10 +64,9 @@ PARAMETERS = (
               "D_c / V_0 at the defaults: steady state at V_0)", POSITIVE),
 )
 P_A, P_B, P_DC, P_V0, P_MU0 = (slot(name) for name in ("rs_a", "rs_b", "rs_D_c", "rs_V_0", "rs_mu_0"))
+# The interface slips at every stress: an error-controlled integrator carries F and theta.
+INTERFACE_SLIPS = True
 REFUSED_BY = {
-    "adaptive": "locates each breaking of the Coulomb bound as an event and resets the spring (the paper's "
-                "law), and rate-and-state friction slips at every stress, with no bound to locate; use a "
-                "fixed-step scheme",
     "event_driven": "its closed-form regimes assume the paper's spring with reset; use a fixed-step scheme",
 }
 # Newton's iterations before the rule stops improving (it converges in a few).
@@ -68,6 +75,7 @@ LN2 = math.log(2.0)
 # The slip rate theta evolves at is capped here (delta_0/tau_0): as N_b -> 0 the
 # interface's rate overflows, and theta, which relaxes to D_c / V, must stay positive.
 RATE_CAP = 1e100
+LOG_RATE_CAP = math.log(RATE_CAP)
 
 
 def initial_state(parameters: dict) -> float:
@@ -179,3 +187,40 @@ def rule_with(evolve):
             return shear, theta, False
         return shear, evolve(theta, rate, h, prm), False
     return rule
+
+
+@njit(inline="always")
+def integrated(theta):
+    """The variable an error-controlled integrator carries for theta: ln theta."""
+    return math.log(theta)
+
+
+@njit(inline="always")
+def stored(log_theta):
+    """theta from the integrated variable."""
+    return math.exp(log_theta)
+
+
+@njit(inline="always")
+def slip_rate(shear, theta, bound_normal, prm):
+    """The interface's slip rate V(F) >= 0 at the spring's displacement F (capped at
+    ``RATE_CAP``, as N_b -> 0 it overflows); 0 at F = 0.  Without a normal force the
+    interface cannot hold any F: the cap."""
+    if shear == 0.0:
+        return 0.0
+    if not bound_normal > 0.0:
+        return RATE_CAP
+    r = prm[P_KT] * abs(shear) / (prm[P_A] * bound_normal)
+    log_scale = math.log(prm[P_V0]) - state_term(theta, prm) / prm[P_A]
+    return math.exp(min(log_slip_rate(r, log_scale)[0], LOG_RATE_CAP))
+
+
+def interface_with(log_state_rate):
+    """The law in continuous time on ln theta, given d(ln theta)/dt =
+    ``log_state_rate(ln theta, V, prm)``: (the interface's slip rate along F,
+    d(ln theta)/dt).  Called, not inlined, as the rule is."""
+    @njit
+    def interface(shear, log_theta, bound_normal, prm):
+        rate = slip_rate(shear, math.exp(log_theta), bound_normal, prm)
+        return math.copysign(rate, shear), log_state_rate(log_theta, rate, prm)
+    return interface

@@ -22,8 +22,9 @@ The contract (``integrators/__init__.py``) as this integrator keeps it:
   flights, slips: the tolerance limits the step), RODAS4 where DOP853's steps would meet
   its stability bound (a long stick whose ringing has died); the hand-over both ways is
   ``methods``'s.  The ``jacobians`` counter counts RODAS4's linearisations.  A step is
-  accepted when the weighted RMS of its embedded error over the five state components is
-  <= 1 (weights atol + rtol max(|y0|, |y1|)).
+  accepted when the weighted RMS of its embedded error over the state components is
+  <= 1 (weights atol + rtol max(|y0|, |y1|)); the friction law's state theta is a sixth
+  component, counted where the law moves it (rate-and-state: ``regimes``).
 * Step caps.  While the plate moves harmonically a step spans at most CYCLE_FRACTION of
   its period, so no landing or grazing contact is stepped over unseen; a long stick
   without vibration is crossed in steps growing sixfold each.  The one exception is a

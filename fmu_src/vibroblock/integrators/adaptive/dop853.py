@@ -20,6 +20,7 @@ from numba import njit
 
 from ...layout import P_ATOL, P_RTOL
 from .regimes import NS, NV, rates
+from .rodas4 import error_components
 from .workspace import EXPLICIT_STAGES, F0, KX, STAGE
 
 TABLEAU = Path(__file__).with_name("dop853_tableau.npz")
@@ -67,7 +68,7 @@ def explicit_step(system, clk, v, t_abs, u, h, ws, out):
         err3 += (e3 / weight) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
-    err = abs(h) * err5 / math.sqrt((err5 + 0.01 * err3) * NS)
+    err = abs(h) * err5 / math.sqrt((err5 + 0.01 * err3) * error_components(system[0]))
     if not math.isfinite(err):
         return math.inf
     return err

@@ -17,11 +17,11 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...dynamics import contact
-from ...laws import friction_energy, friction_spring_force
+from ...laws import friction_energy, friction_integrated, friction_interface_slips, friction_spring_force, friction_stored
 from ...unowned import data_pointer
 from ...layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
                        D_EXT_A, D_EXT_V, D_EXT_Z, D_OMEGA, D_T0, N_OBS, P_MAX_JUMP, P_RTOL, Y_DISSIPATED,
-                       Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+                       Y_E_NORMAL, Y_F, Y_FRICTION_STATE, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..fixed_step import kahan_add, record_observation
 from .dop853 import stiffness
 from .events import EVENT_TOL, first_event, locate_switch
@@ -30,7 +30,7 @@ from .jumps import (STROBE_MIN, STROBE_PAYBACK, STROBE_SHARE, STROBE_TRY, STROBE
 from .methods import (EVENT_SAMPLES, EXPLICIT_CALM, EXPLICIT_STIFF, STIFF_AFTER, STIFF_FORGET, STIFF_HOLD,
                       growth, interpolate, shrink, step, stiffest_rate)
 from .regimes import (CASCADE, EV_CONTACT, EV_DETACH, EV_HOLD, EV_NONE, EV_REARM, EV_RESET_MINUS, EV_RESET_PLUS,
-                      FLIGHT, HELD, LOADED, NS, NV, advance_clock, bound, clearance, clock, plate, rates,
+                      FLIGHT, HELD, LOADED, NS, NV, THETA, advance_clock, bound, clearance, clock, plate, rates,
                       reach_time, regime_after_contact)
 from .rodas4 import EPS, jacobian_norm, linearise, rosenbrock
 from .workspace import F0, KX, PROBE, TRIAL, BEST, EXPLICIT_STAGES, workspace
@@ -89,7 +89,7 @@ def _system(run, ic):
 
 @njit(inline="always")
 def _finite(v):
-    return math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4])
+    return math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4] + v[THETA])
 
 
 @njit(inline="always")
@@ -108,20 +108,23 @@ def _commit(v, acc, src):
     """Take the state of src and add its quadrature increments."""
     for i in range(NS):
         v[i] = src[i]
-    acc[A_PHI], acc[A_PHI_C] = kahan_add(acc[A_PHI], acc[A_PHI_C], src[5])
-    acc[A_WORK] += src[6]
-    acc[A_DISSIPATED] += src[7]
-    acc[A_E_NORMAL] += src[8]
+    acc[A_PHI], acc[A_PHI_C] = kahan_add(acc[A_PHI], acc[A_PHI_C], src[NS])
+    acc[A_WORK] += src[NS + 1]
+    acc[A_DISSIPATED] += src[NS + 2]
+    acc[A_E_NORMAL] += src[NS + 3]
 
 
 @njit
 def _initial_regime(run, v, acc, ic, t_base, clk):
-    """The regime of the stored state, with the friction rule applied to it."""
+    """The regime of the stored state, with the friction rule applied to it (a law whose
+    interface slips has no reset: its spring is released only where the bound's N is not
+    positive)."""
     kind, drv, prm, track_energy = run
     pz, pv = plate(drv, clk, 0.0)
     pen, bound_now = bound(kind, v, t_base, pz, pv, prm)
     if pen > 0.0:
-        if abs(friction_spring_force(kind, v[4], prm)) >= bound_now:
+        slips = friction_interface_slips(kind)
+        if (bound_now <= 0.0 if slips else abs(friction_spring_force(kind, v[4], prm)) >= bound_now):
             if v[4] != 0.0:
                 ic[I_SLIPS] += 1
                 acc[A_DISSIPATED] += friction_energy(kind, v[4], prm)
@@ -135,17 +138,19 @@ def _initial_regime(run, v, acc, ic, t_base, clk):
 
 
 @njit
-def _plan_times(drv, prm, tm):
+def _plan_times(kind, drv, prm, tm):
     """The cap of a step, the period of the jumps (0: none: they need a plate that repeats,
-    the harmonic drive with the external input at rest), the plate's highest point (known
-    then too; nan otherwise), when to move the clock, the first step."""
+    the harmonic drive with the external input at rest, and a friction law without a state
+    of its own: a held block's theta grows without bound), the plate's highest point
+    (known then too; nan otherwise), when to move the clock, the first step."""
     omega = drv[D_OMEGA]
     cap = math.inf
     if omega > 0.0 and drv[D_AMP] != 0.0:
         cap = CYCLE_FRACTION * 2.0 * math.pi / omega
     repeats = cap < math.inf and drv[D_EXT_V] == 0.0 and drv[D_EXT_A] == 0.0
     tm[T_CAP] = cap
-    tm[T_PERIOD] = 2.0 * math.pi / omega if repeats and prm[P_MAX_JUMP] >= STROBE_MIN else 0.0
+    jumps = repeats and prm[P_MAX_JUMP] >= STROBE_MIN and not friction_interface_slips(kind)
+    tm[T_PERIOD] = 2.0 * math.pi / omega if jumps else 0.0
     tm[T_TOP] = abs(drv[D_AMP]) + drv[D_EXT_Z] if repeats else math.nan
     tm[T_REBASE_AFTER] = REBASE_CYCLES * 2.0 * math.pi / omega if cap < math.inf else math.inf
     tm[T_LAST_RESET] = -math.inf
@@ -161,6 +166,7 @@ def _start(run, y, cnt, n0, u_end, clk, ws):
     kind, drv, prm, track_energy = run
     v = np.zeros(NV)
     v[0], v[1], v[2], v[3], v[4] = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
+    v[THETA] = friction_integrated(kind, y[Y_FRICTION_STATE])  # ln theta under rate-and-state
     acc = np.zeros(5)
     acc[A_PHI], acc[A_PHI_C] = y[Y_PHI], y[Y_PHI_C]
     acc[A_WORK], acc[A_DISSIPATED], acc[A_E_NORMAL] = y[Y_WORK], y[Y_DISSIPATED], y[Y_E_NORMAL]
@@ -171,7 +177,7 @@ def _start(run, y, cnt, n0, u_end, clk, ws):
     tm[T_BASE] = drv[D_T0] + n0 * drv[D_DT]  # the time at the clock's origin; local times u count from there
     tm[T_END] = u_end
     _initial_regime(run, v, acc, ic, tm[T_BASE], clk)
-    _plan_times(drv, prm, tm)
+    _plan_times(kind, drv, prm, tm)
     linearise(_system(run, ic), clk, v, tm[T_BASE], 0.0, ws)
     ic[I_JACOBIANS] += 1
     explicit = tm[T_H] * max(jacobian_norm(ws[1]), tm[T_STIFFEST]) < EXPLICIT_CALM
@@ -378,7 +384,10 @@ def _switch(run, v, acc, ic, tm, clk, event):
     elif event == EV_REARM:
         v[4] = 0.0
         ic[I_REGIME] = LOADED
-    else:  # EV_HOLD: the cascade's limit, N reached zero
+    else:  # EV_HOLD: N reached zero (the cascade's limit; a slipping interface's spring released)
+        if v[4] != 0.0:
+            acc[A_DISSIPATED] += friction_energy(kind, v[4], prm)
+            v[4] = 0.0
         ic[I_REGIME] = HELD
 
 
@@ -458,10 +467,11 @@ def evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
                 status = _events(run, v, acc, ic, tm, clk, ws)
         if status != OK:
             break
-    if status == OK and not math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4] + acc[A_PHI] + acc[A_WORK]
-                                          + acc[A_DISSIPATED]):
+    if status == OK and not math.isfinite(v[0] + v[1] + v[2] + v[3] + v[4] + v[THETA] + acc[A_PHI]
+                                          + acc[A_WORK] + acc[A_DISSIPATED]):
         status = NON_FINITE
     out[Y_X], out[Y_Z], out[Y_VX], out[Y_VZ], out[Y_F] = v[0], v[1], v[2], v[3], v[4]
+    out[Y_FRICTION_STATE] = friction_stored(kind, v[THETA])
     out[Y_PHI], out[Y_PHI_C] = acc[A_PHI], acc[A_PHI_C]
     out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL] = acc[A_WORK], acc[A_DISSIPATED], acc[A_E_NORMAL]
     for i in range(N_COSTS):

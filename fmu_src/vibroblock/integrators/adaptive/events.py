@@ -103,7 +103,7 @@ def first_event(taken):
     explicit, system, clk, v, trial, h, u, t_base, ws = taken
     kind, regime, drv, prm, track_energy = system
     probe = ws[0][PROBE]
-    n_events = events_of(regime)[1]
+    n_events = events_of(kind, regime)[1]
     previous = 0.0
     for sample in range(1, EVENT_SAMPLES + 1):
         s = sample / EVENT_SAMPLES
@@ -113,12 +113,12 @@ def first_event(taken):
         earliest = math.inf
         pen, bound_now, spring = switch_values(kind, probe, t_base + (u + s * h), pz, pv, prm)
         for e in range(n_events):
-            g = event_value(event_at(regime, e), pen, bound_now, spring)
+            g = event_value(event_at(kind, regime, e), pen, bound_now, spring)
             if g < 0.0:
                 root = _interpolant_root(taken, e, previous, s, g)
                 if root < earliest:
                     earliest = root
-                    event = event_at(regime, e)
+                    event = event_at(kind, regime, e)
         if event != EV_NONE:
             return event, earliest, s
         previous = s
@@ -134,11 +134,11 @@ def locate_switch(taken, event, s_hi, s_sample):
     (the value dipped below zero and back on the interpolant only: a graze within the
     tolerances)."""
     explicit, system, clk, v, trial, h, u, t_base, ws = taken
-    regime = system[1]
+    kind, regime = system[0], system[1]
     probe, best = ws[0][PROBE], ws[0][BEST]
     e_index = 0
-    for e in range(events_of(regime)[1]):
-        if event_at(regime, e) == event:
+    for e in range(events_of(kind, regime)[1]):
+        if event_at(kind, regime, e) == event:
             e_index = e
     t_abs = t_base + u
     tol = max(EVENT_TOL, 4.0 * EPS * (abs(t_abs) + h))

@@ -42,7 +42,7 @@ from numba import njit
 
 from ...layout import P_ATOL, P_KD, P_MAX_JUMP, P_RTOL, P_VD
 from .methods import EVENT_SAMPLES, growth, sample_state, shrink, step
-from .regimes import NS, NV, event_at, event_value, events_of, plate, rates, switch_values
+from .regimes import NS, NS_MOTION, NV, THETA, event_at, event_value, events_of, plate, rates, switch_values
 from .rodas4 import EPS, linearise
 from .workspace import F0, PROBE, SCRATCH, TRIAL
 
@@ -90,8 +90,8 @@ def _sample_margins(system, clk, explicit, start, end, ws, h, local, t_now, marg
         sample_state(explicit, start, end, ws, h, sample, row)
         pz, pv = plate(drv, clk, local + s * h)
         pen, bound_now, spring = switch_values(kind, row, t_now + s * h, pz, pv, prm)
-        for e in range(events_of(regime)[1]):
-            g = event_value(event_at(regime, e), pen, bound_now, spring)
+        for e in range(events_of(kind, regime)[1]):
+            g = event_value(event_at(kind, regime, e), pen, bound_now, spring)
             if g <= 0.0:
                 return False
             margins[e] = min(margins[e], g)
@@ -118,8 +118,8 @@ def period_map(system, v0, t_abs, shift, clk, plan, hs, n_hs, res, ws, tally):
         probe[i] = v0[i]
     pz, pv = plate(drv, clk, 0.0)
     pen, bound_now, spring = switch_values(kind, v0, t_abs + shift, pz, pv, prm)
-    for e in range(events_of(regime)[1]):
-        margins[e] = event_value(event_at(regime, e), pen, bound_now, spring)
+    for e in range(events_of(kind, regime)[1]):
+        margins[e] = event_value(event_at(kind, regime, e), pen, bound_now, spring)
         if margins[e] <= 0.0:
             return -1
     for i in range(NS):
@@ -247,6 +247,9 @@ def _model_columns(job, t_abs, at):
     for j in range(NS):
         for i in range(NV):
             cols[j, i] = 0.0
+        if j == THETA:  # a law with a state never jumps (driver): theta stays as it is
+            cols[j, j] = 1.0
+            continue
         step_j = STROBE_EPS * max(1.0, abs(y0[j]))
         for side in range(2):
             for i in range(NV):
@@ -321,7 +324,7 @@ def _landing_error(sw, count, mid, prm, period):
     e = ((sw[CHECK_MID][NS] - at_mid) - curvature[0] * float(mid) * mid) / (
         rtol * (abs(base[NS]) + vd * vd * period) + 1e-300)
     err += e * e
-    return math.sqrt(err / (NS + 1))
+    return math.sqrt(err / (NS_MOTION + 1))  # theta's rows are 0 here: jumps run the sticking laws only
 
 
 @njit
@@ -335,7 +338,7 @@ def _try_periods(job, count, t_abs, at, clk_u):
     _period_matrix(sw, mats[G])
     vec, moved = sw[VEC], sw[MOVED]
     _apply_periods(sw, mats, count, vec, moved)
-    if not math.isfinite(vec[0] + vec[1] + vec[2] + vec[3] + vec[4] + vec[5]):
+    if not math.isfinite(vec[0] + vec[1] + vec[2] + vec[3] + vec[4] + vec[NS]):
         return math.inf
     at[1] = clk_u + count * period
     res = (sw[CHECK], sw[MARGINS_MOVED], sw[SCALE_MOVED])
@@ -378,7 +381,7 @@ def stroboscopic(system, v, t_base, clk, u_end, plan, dq, tally, ws):
     returns the time jumped (0 if no jump was taken); dq gets the quadratures' increments,
     tally (accepted, rejected, Jacobians, periods jumped) the costs."""
     prm, period = system[3], plan[0]
-    n_events = events_of(system[1])[1]
+    n_events = events_of(system[0], system[1])[1]
     hs = np.empty(STROBE_STEPS)
     sw = np.zeros((STROBE_ROWS, NA))
     mats = np.zeros((3, NA, NA))

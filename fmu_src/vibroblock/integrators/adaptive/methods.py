@@ -9,7 +9,7 @@ friction-spring rate) < EXPLICIT_CALM).  The explicit pair hands over to RODAS4 
 h rho > EXPLICIT_STIFF on STIFF_AFTER accepted steps (rho from its last two rates:
 Hairer's DOP853 test); RODAS4 hands back, at least STIFF_HOLD steps later, once its step
 is again inside the bound.  A step is accepted when the weighted RMS of its embedded
-error over the five state components is <= 1 (weights atol + rtol max(|y0|, |y1|)); the
+error over the state components (theta where it moves) is <= 1 (weights atol + rtol max(|y0|, |y1|)); the
 next step is h SAFETY err^(-1/(q+1)) (q the estimator's order: 3 for RODAS4, 7 for
 DOP853's combination), within [SHRINK, GROW] h.
 """

@@ -16,6 +16,13 @@ cascade     delta falls through 0        flight
 (F = 0)     B falls through 0            held
 ==========  ===========================  =====================================
 
+A friction law whose interface slips at every stress (rate-and-state: ``INTERFACE_SLIPS``)
+has no reset to locate: its loaded regime watches the contact and its bound's N instead,
+and a bound that falls through 0 ends it (held, the spring's energy dissipated); F then
+relaxes at the interface's slip rate, dF/dt = u_t - V, and the law's state (ln theta:
+``laws.rate_state``) is a sixth state component.  Under the other laws theta's rate is 0 and it rides along
+unchanged (the integration's arithmetic on the other components is the same, to the bit).
+
 Every force, the frame and the energy rates are ``vibroblock.dynamics``'s, the contact
 force and the friction spring the run's laws (``vibroblock.laws``).  Within a contact
 phase the normal force is continued across delta = 0 (the event, not the force, ends the
@@ -35,7 +42,7 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...dynamics import coulomb_bound, energy_rates, force, plate_motion, position_rates, surface_contact
-from ...laws import contact_force, friction_spring_force
+from ...laws import contact_force, friction_interface, friction_interface_slips, friction_spring_force
 from ...layout import D_AMP, D_DT, D_EXT_A, D_EXT_T, D_EXT_V, D_EXT_Z, D_OMEGA, D_T0, P_M, P_MUS, P_VD
 from ...readings import free_flight
 from ..plate import TWO_PI, drive_phase
@@ -45,11 +52,15 @@ FLIGHT, LOADED, HELD, CASCADE = 0, 1, 2, 3
 # Events.
 EV_NONE, EV_CONTACT, EV_DETACH, EV_RESET_PLUS, EV_RESET_MINUS, EV_REARM, EV_HOLD = range(7)
 
-# State vector of the integration: the five state components (x, z, vx, vz, F), then the
-# quadratures (phi, work, dissipation, normal-spring energy), which feed nothing back.
-NS = 5
+# State vector of the integration: the six state components (x, z, vx, vz, F and the
+# friction law's state theta), then the quadratures (phi, work, dissipation,
+# normal-spring energy), which feed nothing back.
+NS = 6
+THETA = 5
 NQ = 4
 NV = NS + NQ
+# The state components every law integrates: the error norms count theta only where it moves.
+NS_MOTION = 5
 
 
 # --------------------------------------------------------------------------- the plate's clock
@@ -102,16 +113,22 @@ def rhs(kind, regime, v, t, pz, pv, prm, track_energy, out):
     rate_x, rate_z = position_rates(kind, vx, vz, cos_a)  # (vx, vz); (u cos a, w) in the tangent frame
     out[0], out[1], out[2], out[3] = rate_x, rate_z, fx * inv_m, fz * inv_m
     out[4] = u_t if regime == LOADED else 0.0
+    out[THETA] = 0.0
+    interface_loss = 0.0
+    if regime == LOADED and friction_interface_slips(kind):
+        slip, out[THETA] = friction_interface(kind, shear, v[THETA], coulomb_bound(kind, normal, x, t, prm), prm)
+        out[4] -= slip
+        interface_loss = friction_spring_force(kind, shear, prm) * slip
     drift = rate_x - prm[P_VD]
-    out[5] = drift * drift
+    out[6] = drift * drift
     if track_energy:
         # Within a contact phase the rates are continued across delta = 0 like the force
         # (so that the quadratures' rows of the Jacobian have no kink): the gate is the regime.
         work, dissipation, storage = energy_rates(kind, x, (vx, vz), shear, t, gate > 0.0,
                                                   (pen, u_n, u_t, cos_a, sin_a, normal), pv, prm)
-        out[6], out[7], out[8] = work, dissipation, storage
+        out[7], out[8], out[9] = work, dissipation + interface_loss, storage
     else:
-        out[6] = out[7] = out[8] = 0.0
+        out[7] = out[8] = out[9] = 0.0
 
 
 @njit(inline="always")
@@ -149,23 +166,25 @@ def event_value(event, pen, bound_now, spring):
 
 
 @njit(inline="always")
-def events_of(regime):
+def events_of(kind, regime):
     """The events a regime watches: (first, count) in the order contact/detach, resets, N."""
     if regime == FLIGHT:
         return EV_CONTACT, 1
-    if regime == LOADED:
+    if regime == LOADED and not friction_interface_slips(kind):
         return EV_DETACH, 3
     return EV_DETACH, 2
 
 
 @njit(inline="always")
-def event_at(regime, i):
+def event_at(kind, regime, i):
     """The regime's i-th event (``events_of``'s order)."""
     if regime == FLIGHT:
         return EV_CONTACT
     if i == 0:
         return EV_DETACH
     if regime == LOADED:
+        if friction_interface_slips(kind):
+            return EV_HOLD  # no reset: the loaded phase ends where its bound's N does
         return EV_RESET_PLUS if i == 1 else EV_RESET_MINUS
     return EV_REARM if regime == HELD else EV_HOLD
 
@@ -183,7 +202,7 @@ def switch_values(kind, v, t, pz, pv, prm):
 def value(kind, regime, i, v, t, pz, pv, prm):
     """The regime's i-th event value at state v, time t, plate (pz, pv)."""
     pen, bound_now, spring = switch_values(kind, v, t, pz, pv, prm)
-    return event_value(event_at(regime, i), pen, bound_now, spring)
+    return event_value(event_at(kind, regime, i), pen, bound_now, spring)
 
 
 @njit(inline="always")

@@ -3,10 +3,12 @@ Wanner, Solving ODEs II, Sec. IV.7: six stages, L-stable and stiffly accurate, s
 far longer than the contact's and the friction spring's periods damps what has rung down
 instead of amplifying it).
 
-It runs on the state (x, z, vx, vz, F) and the quadratures, which ride along as extra
-components that feed nothing back.  Every step solves five linear systems with one LU
+It runs on the state (x, z, vx, vz, F, theta) and the quadratures, which ride along as
+extra components that feed nothing back.  Every step solves six linear systems with one LU
 factorisation of (I/(h gamma) - J); J is the Jacobian of the forces on the
-five-dimensional state by central differences (so any variant, reading or law that
+six-dimensional state by central differences (theta's column only where the friction
+law moves it: elsewhere it is 0, and the factorisation's arithmetic on the other five
+components is what it was without it) (so any variant, reading or law that
 ``dynamics`` computes is differentiated the same way), and the explicit time dependence
 (plate, drive's far end) enters through a difference quotient in t.  Each step carries
 its third-order interpolant (from stages 1-5).
@@ -18,7 +20,8 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...layout import D_AMP, D_OMEGA, P_ATOL, P_RTOL
-from .regimes import NS, NV, plate, rates, rhs
+from ...laws import friction_interface_slips
+from .regimes import NS, NS_MOTION, NV, plate, rates, rhs
 from .workspace import F0, FT, K, RATE, SCRATCH, STAGE
 
 # Hairer & Wanner, Sec. IV.7, Table 7.3: the transformed stages
@@ -118,7 +121,8 @@ def linearise(system, clk, v, t_abs, u, ws):
     rhs(kind, regime, v, t_abs, pz, pv, prm, track_energy, f0)
     for i in range(NV):
         probe[i] = v[i]
-    for j in range(NS):
+    # theta's column only where it moves (else it stays 0, as allocated: its rate is 0)
+    for j in range(NS if friction_interface_slips(kind) else NS_MOTION):
         step = JAC_STEP * max(1.0, abs(v[j]))
         probe[j] = v[j] + step
         up = probe[j] - v[j]
@@ -182,10 +186,17 @@ def rosenbrock(system, clk, v, t_abs, u, h, ws, out):
         weight = atol + rtol * max(abs(v[i]), abs(out[i]))
         e = k[5, i] / weight
         err += e * e
-    err = math.sqrt(err / NS)
+    err = math.sqrt(err / error_components(system[0]))
     if not math.isfinite(err):
         return math.inf
     return err
+
+
+@njit(inline="always")
+def error_components(kind):
+    """The state components the error norms average over: theta only where it moves (its
+    error is 0 otherwise, and the norms stay those of the mechanical state)."""
+    return NS if friction_interface_slips(kind) else NS_MOTION
 
 
 @njit(inline="always")
