@@ -233,13 +233,15 @@ def test_excitation_gives_fmpys_bits(host, fmus, settings):
 
 # ---------------------------------------------------------------- switches by name
 # Every law axis, a reading and the integrator given by the names the FMU's model
-# description lists (-p NAME VALUE); a Real by name too.
+# description lists (-p NAME VALUE), Reals by name too; a drive that makes the block slip
+# within the run, so that the friction law shows.
 BY_NAME = {"BlockA": {"integrator": "rk4", "contact_law": "hertz_hunt_crossley", "friction_law": "rate_state_aging",
-                      "coulomb_normal": "load_only", "flight": "free", "A": 0.5, "omega": 0.8, "rs_D_c": 0.1,
-                      "rs_V_0": 1e-3, "rs_theta_0": 100.0},
+                      "coulomb_normal": "load_only", "flight": "free", "plate_motion": "oblique", "drive_angle": 0.7,
+                      "k_d": 0.1, "V_d": 0.5, "A": 0.5, "omega": 0.8, "rs_D_c": 0.1, "rs_V_0": 1e-3,
+                      "rs_theta_0": 100.0},
            "BlockB": {"integrator": "symplectic_euler", "formulation": "tangent_frame", "friction_law": "rate_state_slip",
-                      "plate_motion": "oblique", "drive_angle": 0.7, "A": 0.5, "omega": 0.8, "rs_D_c": 0.1,
-                      "rs_V_0": 1e-3, "rs_theta_0": 100.0}}
+                      "contact_law": "linear_no_pull", "k_d": 0.1, "V_d": 0.5, "A": 0.5, "omega": 0.8,
+                      "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0}}
 
 
 def by_name_args(settings):

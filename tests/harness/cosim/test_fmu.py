@@ -61,7 +61,7 @@ def test_a_failing_initialization_after_many_collected_instances_returns_fmi2err
     # ... and the plain fmpy run's reaches fmpy's default logger once, with fmi2Error.
     printed = [line for line in lines if line.startswith("[ERROR]")]
     assert len(printed) == 1 and REFUSAL in printed[0], done.stdout[-2000:]
-    assert "raised: fmi2ExitInitializationMode failed with status 3 (error)" in lines
+    assert "raised: fmi2ExitInitializationMode failed with status 3 (error)." in lines
     assert lines[-1] == "alive"
 
 
