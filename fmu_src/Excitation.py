@@ -31,7 +31,7 @@ COMPONENTS_TEXT = ("components of a seismic record_file played in mode 4: 1 = on
 AZIMUTH_TEXT = ("slip direction (+x) of a three-component record (record_components = 2): degrees clockwise from "
                 "north; plate_x = N cos(azimuth) + E sin(azimuth)")
 MODE_TEXT = ("signal f of signal time s = (t - onset)/time_scale; plate_z = amplitude_scale * w * f with w the "
-             "start ramp (1 if ramp_time = 0). 0 = harmonic: amplitude sin(omega s + phase); 1 = linear chirp: "
+             "start ramp (1 if ramp_time = 0); 0 = harmonic: amplitude sin(omega s + phase); 1 = linear chirp: "
              "amplitude sin(theta + phase), frequency linear from omega_start to omega_end over sweep_time; "
              "2 = logarithmic chirp (geometric frequency sweep); 3 = sum of harmonics amplitude_i "
              "sin(omega_i s + phase_i), i = 1..4; 4 = playback of the record in record_file (piecewise-linear "

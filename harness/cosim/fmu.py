@@ -18,11 +18,13 @@ Three layers, each usable alone:
 from __future__ import annotations
 
 import hashlib
+import itertools
 import os
 import re
 import shutil
 import tempfile
 import threading
+import weakref
 from ctypes import byref
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,13 +34,41 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2Boolean, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
-                       fmi2Integer, fmi2Real, fmi2ValueReference)
+                       fmi2Integer, fmi2Real, fmi2ValueReference, printLogMessage)
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_CACHE = REPO_ROOT / ".cache"
 STATUS_LABELS = ("ok", "warning", "discard", "error", "fatal", "pending")
 # Log lines kept per instance: enough to explain the failing call, bounded for long runs.
 LOG_LINES_KEPT = 50
+
+
+# fmpy's native logger proxy (fmpy.logging.addLoggerProxy) formats a message and hands it
+# to one process-wide Python callback: that of the callbacks it was given last.  Had each
+# instance its own callback there, the proxy would keep calling it after the instance was
+# gone and ctypes had freed it, and the next message any FMU logs through the proxy (a
+# plain simulate_fmu run with fmpy's default callbacks included) would call freed memory:
+# a segfault, or another Python function called with the logger's arguments.  So the
+# process has one callback, alive as long as the proxy is, and each instance's callbacks
+# carry a key (componentEnvironment, which the FMU passes back with every message) that
+# routes its messages to its own log; messages without a known key are printed as fmpy's
+# default logger prints them.
+_LOG_ROUTES: dict[int, list[str]] = {}
+_ROUTE_KEYS = itertools.count(1)
+
+
+def _route_message(component_environment, instance, status, category, message) -> None:
+    log = _LOG_ROUTES.get(component_environment or 0)
+    if log is None:
+        printLogMessage(component_environment, instance, status, category, message or b"")
+        return
+    text = message.decode("utf-8", "replace") if message else ""
+    label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
+    log.append(f"[{label}] {text}")
+    del log[:-LOG_LINES_KEPT]
+
+
+_PROCESS_LOGGER = fmi2CallbackLoggerTYPE(_route_message)
 
 
 class FmuError(RuntimeError):
@@ -243,18 +273,17 @@ class FmuInstance:
     # ------------------------------------------------------------------ plumbing
     def _make_callbacks(self) -> fmi2CallbackFunctions:
         # FMUs log printf-style (the vibroblock FMUs pass their text through "%s"); ctypes
-        # cannot read variadic arguments, so fmpy's native proxy formats the message first.
-        def keep(component, instance, status, category, message):
-            text = message.decode("utf-8", "replace") if message else ""
-            label = STATUS_LABELS[status] if 0 <= status < len(STATUS_LABELS) else str(status)
-            self._log.append(f"[{label}] {text}")
-            del self._log[:-LOG_LINES_KEPT]
-
+        # cannot read variadic arguments, so fmpy's native proxy formats the message first,
+        # and passes it to the process's one logger (_PROCESS_LOGGER says why), which
+        # finds this instance's log by the key in componentEnvironment.
+        self._route = next(_ROUTE_KEYS)
+        _LOG_ROUTES[self._route] = self._log
+        weakref.finalize(self, _LOG_ROUTES.pop, self._route, None)
         callbacks = fmi2CallbackFunctions()
-        self._logger = fmi2CallbackLoggerTYPE(keep)  # the C callback must outlive the instance
-        callbacks.logger = self._logger
+        callbacks.logger = _PROCESS_LOGGER
         callbacks.allocateMemory = defaultCallbacks.allocateMemory
         callbacks.freeMemory = defaultCallbacks.freeMemory
+        callbacks.componentEnvironment = self._route
         try:
             from fmpy.logging import addLoggerProxy
 

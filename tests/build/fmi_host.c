@@ -9,9 +9,15 @@
  *   run DIR ID GUID START STOP STEP [options]   simulate like fmpy's simulate_fmu and
  *       print "time value..." per communication point, reals as exact hex floats.
  *       -r VR VALUE / -i VR VALUE / -b VR VALUE   start values (before initialization)
+ *       -p NAME VALUE                              a start value by the variable's name, typed
+ *                                                  as modelDescription.xml declares it; an
+ *                                                  Integer switch also takes one of the names
+ *                                                  its description lists ("3 = rate_state_aging")
  *       -o r|i|b VR                                an output column
  *       -d VRZ VRV VRA AMP OMEGA                   drive three inputs before each step with
  *                                                  AMP sin(OMEGA t) and its two derivatives
+ *   choices DIR NAME                              the names -p accepts for Integer NAME, one
+ *                                                  "value name" per line
  *   check DIR ID GUID VR_X VR_PARAM START_VALUE   the calls FMI 2.0 requires (see check())
  *   cycles DIR ID GUID N VR_OUT                   N instantiate/step/free cycles; prints RSS
  *   multi ID:DIR:GUID:VR ...                      all FMUs, two instances each, one process;
@@ -26,6 +32,7 @@
  * Exit status 0 when everything held; failed checks are printed as "FAIL ...".
  */
 #define _GNU_SOURCE
+#include <ctype.h>
 #include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
@@ -138,6 +145,277 @@ static fmi2Component instantiate(const Fmu* fmu, const char* name, const char* d
     return fmu->fmi2Instantiate(name, 1 /* fmi2CoSimulation */, guid, uri, &callbacks, 0, 0);
 }
 
+/* ---- variables by name, from the FMU's own modelDescription.xml ------------------ */
+
+/* One ScalarVariable: its name, value reference, type element and description, with
+ * XML's character references decoded. */
+typedef struct {
+    char* name;
+    char* description;
+    char type[16]; /* Real, Integer, Boolean, String, Enumeration */
+    fmi2ValueReference vr;
+} Variable;
+
+typedef struct {
+    char* model_name;
+    Variable* variables;
+    int count;
+} ModelDescription;
+
+static char* read_file(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    if (f == NULL) return NULL;
+    size_t size = 0, cap = 1 << 16;
+    char* text = malloc(cap);
+    for (size_t got; text != NULL && (got = fread(text + size, 1, cap - size - 1, f)) > 0;) {
+        size += got;
+        if (size + 1 == cap) text = realloc(text, cap *= 2);
+    }
+    fclose(f);
+    if (text != NULL) text[size] = '\0';
+    return text;
+}
+
+/* The text of an attribute value with &lt; &gt; &amp; &quot; &apos; &#N; &#xN; decoded. */
+static char* xml_text(const char* from, size_t length)
+{
+    char* out = malloc(length + 1);
+    size_t n = 0;
+    for (size_t i = 0; i < length;) {
+        static const struct { const char* entity; char c; } named[] = {
+            {"&lt;", '<'}, {"&gt;", '>'}, {"&amp;", '&'}, {"&quot;", '"'}, {"&apos;", '\''}};
+        int done = 0;
+        for (size_t k = 0; k < sizeof named / sizeof named[0] && !done; k++) {
+            size_t len = strlen(named[k].entity);
+            if (i + len <= length && strncmp(from + i, named[k].entity, len) == 0) {
+                out[n++] = named[k].c;
+                i += len;
+                done = 1;
+            }
+        }
+        if (!done && from[i] == '&' && i + 2 < length && from[i + 1] == '#') {
+            char* end = NULL;
+            int hex = from[i + 2] == 'x' || from[i + 2] == 'X';
+            long code = strtol(from + i + (hex ? 3 : 2), &end, hex ? 16 : 10);
+            if (end != NULL && end < from + length && *end == ';' && code > 0 && code < 128) {
+                out[n++] = (char)code; /* the descriptions' separators are ASCII; others stay as written */
+                i = (size_t)(end - from) + 1;
+                done = 1;
+            }
+        }
+        if (!done) out[n++] = from[i++];
+    }
+    out[n] = '\0';
+    return out;
+}
+
+/* The value of attribute NAME in the start tag [tag, end), or NULL. */
+static char* attribute(const char* tag, const char* end, const char* name)
+{
+    size_t len = strlen(name);
+    for (const char* p = tag + 1; p < end; p++) {
+        if (*p == '"' || *p == '\'') { /* skip another attribute's value */
+            const char* close = memchr(p + 1, *p, (size_t)(end - p - 1));
+            if (close == NULL) return NULL;
+            p = close;
+            continue;
+        }
+        if ((p[-1] == ' ' || p[-1] == '\t' || p[-1] == '\n' || p[-1] == '\r') && (size_t)(end - p) > len &&
+            strncmp(p, name, len) == 0) {
+            const char* q = p + len;
+            while (q < end && (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r')) q++;
+            if (q >= end || *q != '=') continue;
+            q++;
+            while (q < end && (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r')) q++;
+            if (q >= end || (*q != '"' && *q != '\'')) return NULL;
+            const char* close = memchr(q + 1, *q, (size_t)(end - q - 1));
+            return close == NULL ? NULL : xml_text(q + 1, (size_t)(close - q - 1));
+        }
+    }
+    return NULL;
+}
+
+/* The end of the start tag beginning at TAG ('>' outside quoted values), or NULL. */
+static const char* tag_end(const char* tag)
+{
+    for (const char* p = tag; *p; p++) {
+        if (*p == '"' || *p == '\'') {
+            p = strchr(p + 1, *p);
+            if (p == NULL) return NULL;
+        } else if (*p == '>') {
+            return p;
+        }
+    }
+    return NULL;
+}
+
+/* The model description of the FMU extracted in DIR; exits with a one-line message if
+ * it cannot be read. */
+static ModelDescription read_model_description(const char* dir)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/modelDescription.xml", dir);
+    char* xml = read_file(path);
+    if (xml == NULL) {
+        fprintf(stderr, "fmi_host: cannot read %s\n", path);
+        exit(1);
+    }
+    ModelDescription md = {NULL, NULL, 0};
+    const char* root = strstr(xml, "<fmiModelDescription");
+    const char* root_end = root ? tag_end(root) : NULL;
+    md.model_name = root_end ? attribute(root, root_end, "modelName") : NULL;
+    int cap = 0;
+    for (const char* p = xml; (p = strstr(p, "<ScalarVariable")) != NULL;) {
+        const char* end = tag_end(p);
+        if (end == NULL) break;
+        Variable v = {attribute(p, end, "name"), attribute(p, end, "description"), "", 0};
+        char* vr = attribute(p, end, "valueReference");
+        /* The type is the first element inside: <Real .../>, <Integer .../>, ... */
+        const char* child = end[-1] == '/' ? NULL : strchr(end, '<');
+        if (child != NULL) sscanf(child + 1, "%15[A-Za-z]", v.type);
+        if (v.name != NULL && vr != NULL) {
+            v.vr = (fmi2ValueReference)strtoul(vr, NULL, 10);
+            if (md.count == cap) md.variables = realloc(md.variables, sizeof(Variable) * (size_t)(cap = cap ? 2 * cap : 64));
+            md.variables[md.count++] = v;
+        }
+        free(vr);
+        p = end;
+    }
+    free(xml);
+    return md;
+}
+
+static const Variable* find_variable(const ModelDescription* md, const char* name)
+{
+    for (int i = 0; i < md->count; i++)
+        if (strcmp(md->variables[i].name, name) == 0) return &md->variables[i];
+    return NULL;
+}
+
+/* The named values of an Integer switch as its description lists them, "0 = name: ...;
+ * 1 = name ...": a number, " = " and a name, at the start of the description or after one
+ * of ;:,( and blanks (the harness reads them the same way: harness/cosim/fmu.py, _CHOICE).
+ * Calls FOUND(code, label, length, context) for each, in the order of the description. */
+static void each_choice(const char* description, void (*found)(long, const char*, size_t, void*), void* context)
+{
+    if (description == NULL) return;
+    for (const char* p = description; *p;) {
+        const char* q = p;
+        if (p != description) {
+            if (strchr(";:,(", *p) == NULL) { p++; continue; }
+            q = p + 1;
+            while (*q && isspace((unsigned char)*q)) q++;
+        }
+        const char* digits = q + (*q == '-');
+        const char* after = digits;
+        while (isdigit((unsigned char)*after)) after++;
+        if (after > digits && strncmp(after, " = ", 3) == 0 &&
+            (isalpha((unsigned char)after[3]) || after[3] == '_')) {
+            const char* label = after + 3;
+            size_t length = 0;
+            while (isalnum((unsigned char)label[length]) || label[length] == '_') length++;
+            found(strtol(q, NULL, 10), label, length, context);
+            p = label + length;
+        } else {
+            p++;
+        }
+    }
+}
+
+typedef struct { const char* wanted; long code; int matched; char* listing; size_t used, cap; } ChoiceLookup;
+
+static void match_choice(long code, const char* label, size_t length, void* context)
+{
+    ChoiceLookup* look = context;
+    if (look->wanted != NULL && strlen(look->wanted) == length && strncmp(look->wanted, label, length) == 0) {
+        look->code = code; /* a name listed twice takes its last code, as the harness's dict does */
+        look->matched = 1;
+    }
+    char entry[256];
+    snprintf(entry, sizeof entry, "%ld = %.*s", code, (int)length, label);
+    for (const char* seen = look->listing; seen != NULL && (seen = strstr(seen, entry)) != NULL; seen++)
+        if ((seen == look->listing || seen[-1] == ' ') && (seen[strlen(entry)] == ',' || seen[strlen(entry)] == '\0'))
+            return; /* listed once already (a description may name a choice twice) */
+    size_t need = look->used + strlen(entry) + 3;
+    if (need > look->cap) look->listing = realloc(look->listing, look->cap = 2 * need);
+    look->used += (size_t)sprintf(look->listing + look->used, "%s%s", look->used ? ", " : "", entry);
+}
+
+/* VALUE for variable NAME as the FMU's type: a number, an Integer switch's choice by name,
+ * or true/false for a Boolean.  A name the description does not list, or a variable the
+ * FMU does not have, ends the master with a one-line message before the FMU is loaded. */
+static void resolve(const ModelDescription* md, const char* name, const char* value, char* kind,
+                    fmi2ValueReference* vr, double* number)
+{
+    const char* model = md->model_name ? md->model_name : "the FMU";
+    const Variable* v = find_variable(md, name);
+    if (v == NULL) {
+        fprintf(stderr, "fmi_host: %s has no variable %s (its modelDescription.xml)\n", model, name);
+        exit(1);
+    }
+    *vr = v->vr;
+    char* end = NULL;
+    double parsed = strtod(value, &end);
+    int numeric = end != value && *end == '\0';
+    if (strcmp(v->type, "Real") == 0) {
+        *kind = 'r';
+        if (!numeric) {
+            fprintf(stderr, "fmi_host: %s: %s is a Real and cannot take '%s': give a number\n", model, name, value);
+            exit(1);
+        }
+        *number = parsed;
+    } else if (strcmp(v->type, "Integer") == 0) {
+        *kind = 'i';
+        ChoiceLookup look = {value, 0, 0, NULL, 0, 0};
+        each_choice(v->description, match_choice, &look);
+        if (look.matched) {
+            *number = (double)look.code;
+        } else if (numeric && parsed == floor(parsed) && parsed >= -2147483648.0 && parsed < 2147483648.0) {
+            *number = parsed;
+        } else {
+            fprintf(stderr, "fmi_host: %s: %s = '%s' is not one of its choices (%s; the FMU's modelDescription.xml)\n",
+                    model, name, value, look.used ? look.listing : "it lists none: give a whole number");
+            exit(1);
+        }
+        free(look.listing);
+    } else if (strcmp(v->type, "Boolean") == 0) {
+        *kind = 'b';
+        if (strcmp(value, "true") == 0 || strcmp(value, "1") == 0) *number = 1;
+        else if (strcmp(value, "false") == 0 || strcmp(value, "0") == 0) *number = 0;
+        else {
+            fprintf(stderr, "fmi_host: %s: %s is a Boolean and cannot take '%s': give true or false\n", model, name,
+                    value);
+            exit(1);
+        }
+    } else {
+        fprintf(stderr, "fmi_host: %s: %s is a %s variable; the master sets Real, Integer and Boolean ones\n", model,
+                name, v->type[0] ? v->type : "typeless");
+        exit(1);
+    }
+}
+
+static void print_choice(long code, const char* label, size_t length, void* context)
+{
+    (void)context;
+    printf("%ld %.*s\n", code, (int)length, label);
+}
+
+/* ---- choices: the named values of an Integer switch, as `run -p` resolves them ---- */
+
+static int choices(int argc, char** argv)
+{
+    if (argc < 4) return 2;
+    ModelDescription md = read_model_description(argv[2]);
+    const Variable* v = find_variable(&md, argv[3]);
+    if (v == NULL || strcmp(v->type, "Integer") != 0) {
+        fprintf(stderr, "fmi_host: %s is not an Integer variable of %s\n", argv[3], argv[2]);
+        return 1;
+    }
+    each_choice(v->description, print_choice, NULL);
+    return 0;
+}
+
 /* ---- run ---------------------------------------------------------------------- */
 
 typedef struct { char kind; fmi2ValueReference vr; } Column;
@@ -168,12 +446,33 @@ static int run(int argc, char** argv)
     if (argc < 8) return 2;
     const char *dir = argv[2], *id = argv[3], *guid = argv[4];
     double start = strtod(argv[5], NULL), stop = strtod(argv[6], NULL), h = strtod(argv[7], NULL);
+    /* Parameters given by name (-p) are resolved before the FMU is loaded, so a wrong name
+     * ends the run before any Python starts. */
+    enum { MAX_NAMED = 64 };
+    char named_kind[MAX_NAMED];
+    fmi2ValueReference named_vr[MAX_NAMED];
+    double named_value[MAX_NAMED];
+    int nnamed = 0;
+    ModelDescription md = {NULL, NULL, 0};
+    for (int i = 8; i < argc; i++) {
+        if (strcmp(argv[i], "-d") == 0) i += 5;
+        else if (strcmp(argv[i], "-p") == 0 && i + 2 < argc) {
+            if (md.variables == NULL) md = read_model_description(dir);
+            if (nnamed == MAX_NAMED) {
+                fprintf(stderr, "fmi_host: more than %d parameters given by name\n", MAX_NAMED);
+                return 1;
+            }
+            resolve(&md, argv[i + 1], argv[i + 2], &named_kind[nnamed], &named_vr[nnamed], &named_value[nnamed]);
+            nnamed++;
+            i += 2;
+        } else if (argv[i][0] == '-') i += 2;
+    }
     Fmu fmu;
     load(&fmu, dir, id);
     fmi2Component c = instantiate(&fmu, "run", dir, guid);
     if (c == NULL) { printf("FAIL instantiate returned NULL\n"); return 1; }
     Column cols[64];
-    int ncols = 0, drive = 0;
+    int ncols = 0, drive = 0, named = 0;
     fmi2ValueReference drive_vr[3] = {0, 0, 0};
     double amp = 0, omega = 0;
     for (int i = 8; i < argc; i++) {
@@ -190,10 +489,16 @@ static int run(int argc, char** argv)
         } else if (argv[i][0] == '-' && i + 2 < argc) {
             fmi2ValueReference vr = (fmi2ValueReference)strtoul(argv[i + 1], NULL, 10);
             double value = strtod(argv[i + 2], NULL);
+            char kind = argv[i][1];
+            if (kind == 'p') { /* resolved above, in the same order */
+                kind = named_kind[named];
+                vr = named_vr[named];
+                value = named_value[named++];
+            }
             int ivalue = (int)value, s = ERROR;
-            if (argv[i][1] == 'r') s = fmu.fmi2SetReal(c, &vr, 1, &value);
-            else if (argv[i][1] == 'i') s = fmu.fmi2SetInteger(c, &vr, 1, &ivalue);
-            else if (argv[i][1] == 'b') s = fmu.fmi2SetBoolean(c, &vr, 1, &ivalue);
+            if (kind == 'r') s = fmu.fmi2SetReal(c, &vr, 1, &value);
+            else if (kind == 'i') s = fmu.fmi2SetInteger(c, &vr, 1, &ivalue);
+            else if (kind == 'b') s = fmu.fmi2SetBoolean(c, &vr, 1, &ivalue);
             CHECK(s == OK, "setting %s %s", argv[i + 1], argv[i + 2]);
             i += 2;
         }
@@ -489,6 +794,7 @@ int main(int argc, char** argv)
     else if (argc > 1 && strcmp(argv[1], "cycles") == 0) status = cycles(argc, argv);
     else if (argc > 1 && strcmp(argv[1], "multi") == 0) status = multi(argc, argv);
     else if (argc > 1 && strcmp(argv[1], "bench") == 0) status = bench(argc, argv, started);
+    else if (argc > 1 && strcmp(argv[1], "choices") == 0) status = choices(argc, argv);
     if (status == 2) fprintf(stderr, "usage: see the comment at the top of fmi_host.c\n");
     return status;
 }

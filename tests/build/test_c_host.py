@@ -231,6 +231,89 @@ def test_excitation_gives_fmpys_bits(host, fmus, settings):
     assert np.ptp(ours[:, 1]) > 0.5
 
 
+# ---------------------------------------------------------------- switches by name
+# Every law axis, a reading and the integrator given by the names the FMU's model
+# description lists (-p NAME VALUE), Reals by name too; a drive that makes the block slip
+# within the run, so that the friction law shows.
+BY_NAME = {"BlockA": {"integrator": "rk4", "contact_law": "hertz_hunt_crossley", "friction_law": "rate_state_aging",
+                      "coulomb_normal": "load_only", "flight": "free", "plate_motion": "oblique", "drive_angle": 0.7,
+                      "k_d": 0.1, "V_d": 0.5, "A": 0.5, "omega": 0.8, "rs_D_c": 0.1, "rs_V_0": 1e-3,
+                      "rs_theta_0": 100.0},
+           "BlockB": {"integrator": "symplectic_euler", "formulation": "tangent_frame", "friction_law": "rate_state_slip",
+                      "contact_law": "linear_no_pull", "k_d": 0.1, "V_d": 0.5, "A": 0.5, "omega": 0.8,
+                      "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0}}
+
+
+def by_name_args(settings):
+    return [arg for name, value in settings.items() for arg in ("-p", name, str(value))]
+
+
+@pytest.mark.parametrize("name", sorted(BY_NAME))
+def test_switches_set_by_name_give_the_bits_of_their_values_and_fmpys(host, fmus, name):
+    from harness.cosim.fmu import FmuInterface
+
+    folder, md = fmus[name]
+    settings = BY_NAME[name]
+    as_numbers = FmuInterface(folder).typed(settings)  # the harness's reading of the same names
+    assert as_numbers["friction_law"] in (3, 4) and all(isinstance(v, (int, float)) for v in as_numbers.values())
+    start, stop, step = 0.0, 20.0, float(md.defaultExperiment.stepSize)
+    outputs = [arg for v in columns(md) for arg in ("-o", KIND[v.type], v.valueReference)]
+    head = ["run", folder, md.coSimulation.modelIdentifier, md.guid, repr(start), repr(stop), repr(step)]
+    done = run_host(host, *head, *by_name_args(settings), *outputs)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    named = np.array([[float.fromhex(x) if x.startswith(("0x", "-0x")) else float(x) for x in line.split()]
+                      for line in done.stdout.splitlines()])
+    assert_same_bits(named, host_run(host, fmus, name, as_numbers, start, stop, step))
+    result = simulate_fmu(str(folder), start_time=start, stop_time=stop, output_interval=step,
+                          start_values=as_numbers, output=[v.name for v in columns(md)])
+    assert_same_bits(named, as_table(result, md))
+    # The laws chosen by name were run: another friction law moves the block differently.
+    other = host_run(host, fmus, name, {**as_numbers, "friction_law": 0}, start, stop, step)
+    assert other.tobytes() != named.tobytes()
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_master_reads_each_switchs_names_as_the_harness_does(host, fmus, name):
+    from harness.cosim.fmu import FmuInterface
+
+    folder, md = fmus[name]
+    interface = FmuInterface(folder)
+    switches = [v.name for v in md.modelVariables if v.type == "Integer" and v.causality == "parameter"]
+    assert switches
+    for switch in switches:
+        done = run_host(host, "choices", folder, switch)
+        assert done.returncode == 0, done.stderr
+        listed = {}
+        for line in done.stdout.splitlines():
+            code, label = line.split()
+            listed[label] = int(code)  # a name listed twice takes its last value, as in the harness
+        assert listed == interface.choices(switch), switch
+        if switch == "mode":  # each signal by name, the default's too
+            assert listed["harmonic"] == 0 and listed["playback"] == 4
+
+
+@pytest.mark.parametrize("option, message", [
+    (("friction_law", "rate_state_agin"),
+     "friction_law = 'rate_state_agin' is not one of its choices (0 = cundall_strack, 1 = cundall_strack_at_bound, "
+     "2 = cundall_strack_kinetic, 3 = rate_state_aging, 4 = rate_state_slip; the FMU's modelDescription.xml)"),
+    (("integrator", "rk5"), "integrator = 'rk5' is not one of its choices (0 = symplectic_euler, 1 = rk4, "
+                            "2 = event_driven, 3 = implicit_contact, 4 = adaptive;"),
+    (("integrator", "2.5"), "integrator = '2.5' is not one of its choices"),
+    (("frictionlaw", "3"), "BlockA has no variable frictionlaw"),
+    (("k_n", "stiff"), "k_n is a Real and cannot take 'stiff': give a number"),
+    (("energy_balance", "yes"), "energy_balance is a Boolean and cannot take 'yes': give true or false"),
+])
+def test_a_name_the_fmu_does_not_list_ends_the_run_with_one_line(host, fmus, option, message):
+    folder, md = fmus["BlockA"]
+    z = next(v.valueReference for v in md.modelVariables if v.name == "z")
+    done = run_host(host, "run", folder, "BlockA", md.guid, "0", "1", "0.5", "-p", "A", "0.5", "-p", *option,
+                    "-o", "r", z)
+    assert done.returncode == 1  # an exit of its own, not a signal
+    assert done.stdout == ""  # nothing was run
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("fmi_host: BlockA") and message in lines[0], done.stderr
+
+
 # ---------------------------------------------------------------- what FMI 2.0 requires
 @pytest.mark.parametrize("name, output, parameter", [
     ("BlockA", "z", "k_t"), ("BlockB", "x", "A_x"), ("BlockC", "z", "P_l"), ("Excitation", "plate_z", "omega"),
