@@ -4,6 +4,9 @@ of the next large event against the loading period, at fixed acceleration amplit
 
     python examples/chain_rate_state_triggering.py [--phases 0.3,0.6,0.9]
         [--periods 10,20,50,100,200,500,1000,2000] [--accelerations 0.005,0.02]
+        [--blocks 16] [--seed 1] [--load-spread 0.3] [--friction-law 3]
+
+(--blocks 1 --load-spread 0 is the single block under the same law.)
 
 The chain (16 blocks, aging law, velocity weakening, weights spread by 30 %) is loaded
 through three large events; at phase p of the next, undisturbed cycle the plate starts to
@@ -17,6 +20,7 @@ and Cochard 2003: no dependence on P below T_0, a strong one above).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 import time
@@ -61,14 +65,30 @@ def _spread(values) -> str:
     return f"{min(finite):.1f} to {max(finite):.1f}" + (f" ({len(values) - len(finite)} nan)" if len(finite) < len(values) else "")
 
 
+def study_settings(args):
+    """The study's chain with the options given on the command line replaced."""
+    from harness.chain.triggering import RATE_STATE_STUDY
+
+    changes = {name: value for name, value in (("n_blocks", args.blocks), ("seed", args.seed),
+                                               ("load_spread", args.load_spread)) if value is not None}
+    if args.friction_law is not None:
+        changes["parameters"] = tuple((name, args.friction_law if name == "friction_law" else value)
+                                      for name, value in RATE_STATE_STUDY.parameters)
+    return dataclasses.replace(RATE_STATE_STUDY, **changes)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     floats = lambda text: tuple(float(v) for v in text.split(","))  # noqa: E731
     parser.add_argument("--phases", type=floats, default=(0.3, 0.6, 0.9))
     parser.add_argument("--periods", type=floats, default=(10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0))
     parser.add_argument("--accelerations", type=floats, default=(0.005, 0.02))
+    parser.add_argument("--blocks", type=int, help="chain length (default: the study's 16)")
+    parser.add_argument("--seed", type=int, help="seed of the weights' draw (default: the study's 1)")
+    parser.add_argument("--load-spread", type=float, help="spread of the weights (default: the study's 0.3)")
+    parser.add_argument("--friction-law", type=int, choices=(3, 4), help="3 aging (default), 4 slip law")
     args = parser.parse_args(argv)
-    run_experiment(args.phases, args.periods, args.accelerations)
+    run_experiment(args.phases, args.periods, args.accelerations, study_settings(args))
     return 0
 
 
