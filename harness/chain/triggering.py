@@ -1,5 +1,6 @@
-"""Triggered events in the chain: a harmonic burst of the plate at a chosen phase of the
-loading cycle, and the clock advance of the next large event.
+"""Triggered events in the chain: a plate motion (a harmonic burst, a chirp, a real
+record) at a chosen phase of the loading cycle, and the clock advance of the next large
+event.
 
 The experiment (``examples/chain_triggering.py`` runs it and prints the table):
 
@@ -17,6 +18,17 @@ The experiment (``examples/chain_triggering.py`` runs it and prints the table):
 3. The clock advance is t_ref - (start of the next large event after t_b): positive, the
    burst brought it forward.  The event is *triggered* if it comes earlier than the
    reference and starts during the burst.
+
+The same experiment takes any :class:`PlateSignal` in place of the burst
+(:func:`signal_advance`): :class:`Burst`, :class:`Chirp` (a Hann-tapered linear or
+logarithmic sweep, scaled by acceleration like the burst) and :class:`RecordSignal`
+(the vertical acceleration of a processed record, e.g. obspy's example event, stretched
+in time and scaled to a peak acceleration by the product's record playback,
+``harness.ground.excitation``).  Each starts at t_b; after its end the plate rests at
+the signal's last height.  The row also counts the smaller events between t_b and the
+large one.  :func:`periodic_advance` keeps a :class:`Harmonic` plate
+acceleration a sin(2 pi tau / P) up until the event: the periodic loading of Perfettini
+et al.
 
 The burst is scaled by its acceleration: in contact the plate's acceleration changes the
 normal force, and with it the Coulomb bound mu_s N, by m a (the stress perturbation of
@@ -41,6 +53,9 @@ class TriggerSettings:
     n_blocks: int = 16
     mu_s_spread: float = 0.3
     seed: int = 1
+    load_spread: float = 0.0
+    # Any other parameter of the chain or its blocks (e.g. a friction law), as (name, value) pairs.
+    parameters: tuple = ()
     large_fraction: float = 0.5  # an event of at least this fraction of the blocks is large
     warmup: int = 3  # large events before the reference cycle
     snapshot_interval: float = 200.0
@@ -66,8 +81,13 @@ def _large(chain: Chain, settings: TriggerSettings, since: float):
     return next((e for e in chain.events if e[0] >= since and e[3] >= threshold), None)
 
 
+def _unstarted_chain(settings: TriggerSettings) -> Chain:
+    return Chain(settings.n_blocks, mu_s_spread=settings.mu_s_spread, seed=settings.seed,
+                 load_spread=settings.load_spread, **dict(settings.parameters))
+
+
 def new_chain(settings: TriggerSettings) -> Chain:
-    chain = Chain(settings.n_blocks, mu_s_spread=settings.mu_s_spread, seed=settings.seed)
+    chain = _unstarted_chain(settings)
     chain.start()
     return chain
 
@@ -98,7 +118,7 @@ def restored(reference: Reference, settings: TriggerSettings, t_b: float) -> Cha
                       default=reference.snapshots[0])
     if time > t_b:
         raise ValueError(f"no snapshot before t_b = {t_b:g}: the first is at {time:g}")
-    chain = Chain(settings.n_blocks, mu_s_spread=settings.mu_s_spread, seed=settings.seed)
+    chain = _unstarted_chain(settings)
     chain.set_state(state)
     if t_b > chain.time:
         chain.advance_to(t_b)
@@ -117,31 +137,225 @@ def burst(amplitude: float, period: float, cycles: int, tau: float) -> tuple[flo
             amplitude * (-w * w * s * h + 2.0 * w * c * dh + s * ddh))
 
 
+class PlateSignal:
+    """A plate motion that starts at tau = 0: (height, velocity, acceleration) at tau, its
+    ``duration``, the ``step`` at which the chain is given it, and the motion the plate
+    keeps ``after`` it (height, velocity, acceleration at its end)."""
+
+    duration: float
+    step: float
+
+    def __call__(self, tau: float) -> tuple[float, float, float]:
+        raise NotImplementedError
+
+    @property
+    def after(self) -> tuple[float, float, float]:
+        """The plate's motion from the signal's end on: at rest at its last height."""
+        return (float(self(self.duration)[0]), 0.0, 0.0)
+
+
+class Burst(PlateSignal):
+    """The Hann-tapered harmonic burst of :func:`burst`, of acceleration amplitude
+    ``acceleration``: height amplitude acceleration (P / 2 pi)^2."""
+
+    def __init__(self, acceleration: float, period: float, cycles: int, steps_per_period: int):
+        self.amplitude = acceleration * (period / (2.0 * math.pi)) ** 2
+        self.period, self.cycles = period, cycles
+        self.duration, self.step = cycles * period, period / steps_per_period
+
+    def __call__(self, tau):
+        return burst(self.amplitude, self.period, self.cycles, tau)
+
+    @property
+    def after(self):
+        return (0.0, 0.0, 0.0)
+
+
+class Harmonic(PlateSignal):
+    """Periodic loading: the plate's acceleration is a sin(2 pi tau / P) from tau = 0 on,
+    held for ``duration``, the plate starting at rest:
+
+        v = (a / w) (1 - cos w tau),   z = (a / w) tau - (a / w^2) sin w tau,   w = 2 pi / P.
+
+    Height, velocity and acceleration start at zero without a jump, whatever P: no ramp
+    is needed.  (A ramp of z = A sin(w tau) over a fixed time would have to bring the
+    plate to the speed a / w within it, an acceleration of order a P / (2 pi ramp) that
+    exceeds a at long periods.)  The price is the plate's mean rise at a / w: a uniform
+    motion, which the flat plate's contact (it sees the relative penetration and its
+    rate only) does not feel.  After the duration the plate goes on at its last velocity."""
+
+    def __init__(self, acceleration: float, period: float, duration: float, steps_per_period: int = 64):
+        self.acceleration, self.omega = acceleration, 2.0 * math.pi / period
+        self.duration, self.step = duration, period / steps_per_period
+
+    def __call__(self, tau):
+        if tau < 0.0:
+            return 0.0, 0.0, 0.0
+        if tau > self.duration:
+            z, v, _ = self.after
+            return z + v * (tau - self.duration), v, 0.0
+        a, w = self.acceleration, self.omega
+        return a / w * tau - a / (w * w) * math.sin(w * tau), a / w * (1.0 - math.cos(w * tau)), a * math.sin(w * tau)
+
+    @property
+    def after(self):
+        z, v, _ = self(self.duration)
+        return z, v, 0.0
+
+
+class Chirp(PlateSignal):
+    """A Hann-tapered sweep from period ``period_start`` to ``period_end`` over ``duration``,
+    linear or logarithmic in frequency, scaled by acceleration:
+
+        z = a h(tau) sin(phi(tau)) / omega(tau)^2,   h = sin^2(pi tau / D),
+
+    with phi' = omega the instantaneous angular frequency:
+    - linear: omega = omega_0 + (omega_1 - omega_0) tau / D, phi = omega_0 tau + (omega_1 - omega_0) tau^2 / 2D;
+    - log: omega = omega_0 exp(k tau), k = ln(omega_1 / omega_0) / D, phi = omega_0 (exp(k tau) - 1) / k.
+
+    Dividing by omega^2 makes the acceleration's leading term -a h sin(phi), so ``a`` is
+    the acceleration amplitude at every frequency, as for the bursts; velocity and
+    acceleration are the exact derivatives of the height (the slow terms included).
+    Height and velocity vanish at both ends; the taper's curvature 2 (pi/D)^2 leaves an
+    acceleration a P^2 sin(phi) / (2 D^2) at the end (P the end's period), a small step
+    for a chirp of many periods."""
+
+    SWEEPS = ("linear", "log")
+
+    def __init__(self, acceleration: float, period_start: float, period_end: float, duration: float,
+                 sweep: str = "log", steps_per_period: int = 64):
+        if sweep not in self.SWEEPS:
+            raise ValueError(f"sweep = {sweep!r}: a chirp sweeps 'linear' or 'log' in frequency")
+        if not (period_start > 0.0 and period_end > 0.0 and duration > 0.0):
+            raise ValueError("a chirp's periods and duration must be > 0")
+        self.acceleration, self.sweep, self.duration = acceleration, sweep, duration
+        self.omega_start, self.omega_end = 2.0 * math.pi / period_start, 2.0 * math.pi / period_end
+        self.step = min(period_start, period_end) / steps_per_period
+        self.rate = (self.omega_end - self.omega_start) / duration if sweep == "linear" else \
+            math.log(self.omega_end / self.omega_start) / duration
+
+    def frequency(self, tau):
+        """omega(tau) and its first two derivatives."""
+        if self.sweep == "linear":
+            return self.omega_start + self.rate * tau, self.rate, 0.0
+        omega = self.omega_start * math.exp(self.rate * tau)
+        return omega, self.rate * omega, self.rate * self.rate * omega
+
+    def phase(self, tau):
+        if self.sweep == "linear":
+            return self.omega_start * tau + 0.5 * self.rate * tau * tau
+        if self.rate == 0.0:
+            return self.omega_start * tau
+        return self.omega_start * math.expm1(self.rate * tau) / self.rate
+
+    def __call__(self, tau):
+        if not 0.0 <= tau <= self.duration:
+            return 0.0, 0.0, 0.0
+        W = math.pi / self.duration
+        h, dh, ddh = math.sin(W * tau) ** 2, W * math.sin(2.0 * W * tau), 2.0 * W * W * math.cos(2.0 * W * tau)
+        omega, d_omega, dd_omega = self.frequency(tau)
+        q = 1.0 / (omega * omega)  # the acceleration scaling 1/omega^2 and its derivatives
+        dq = -2.0 * d_omega / omega ** 3
+        ddq = 6.0 * d_omega * d_omega / omega ** 4 - 2.0 * dd_omega / omega ** 3
+        g, dg, ddg = h * q, dh * q + h * dq, ddh * q + 2.0 * dh * dq + h * ddq
+        phi = self.phase(tau)
+        s, c = math.sin(phi), math.cos(phi)
+        a = self.acceleration
+        return (a * g * s, a * (dg * s + g * omega * c),
+                a * (ddg * s + (2.0 * dg * omega + g * d_omega) * c - g * omega * omega * s))
+
+    @property
+    def after(self):
+        return (0.0, 0.0, 0.0)
+
+
+class RecordSignal(PlateSignal):
+    """A record's vertical motion played from tau = 0, stretched by ``time_scale`` (model time
+    units per record second) and scaled so that its peak acceleration is
+    ``peak_acceleration`` (in g), by the playback the Excitation FMU runs
+    (``harness.ground.excitation``: piecewise-linear acceleration, its exact integrals).
+    ``motion``: a processed GroundMotion; by default the strong-motion part of obspy's
+    example event (``harness.ground.triggering.triggering_motion``)."""
+
+    def __init__(self, peak_acceleration: float, time_scale: float = 200.0, motion=None,
+                 samples_per_step: float = 0.5):
+        from ..ground.excitation import excitation_of, peak_scaled_parameters, playback_of
+
+        if motion is None:
+            from ..ground.triggering import triggering_motion
+            motion = triggering_motion()
+        record = playback_of(motion)
+        self.excitation = excitation_of(record, **peak_scaled_parameters(record, peak_acceleration, time_scale))
+        self.duration = record.duration * time_scale
+        self.step = record.dt * time_scale * samples_per_step  # the chain is given the motion twice a sample
+
+    def __call__(self, tau):
+        z, v, a = self.excitation.evaluate(float(tau))
+        return float(z), float(v), float(a)
+
+
+def signal_advance(reference: Reference, settings: TriggerSettings, phase: float, signal: PlateSignal) -> dict:
+    """The plate moves by ``signal`` from phase ``phase`` of the reference cycle on: the
+    next large event's start, the clock advance and whether the signal triggered it
+    (the event came earlier than the reference and started while the signal played)."""
+    t_b = reference.t_s + phase * reference.cycle
+    chain = restored(reference, settings, t_b)
+    end_of_signal = t_b + signal.duration
+    t, k = t_b, 0
+    while _large(chain, settings, t_b) is None:
+        if t < end_of_signal:
+            chain.set_plate_input(*signal(t - t_b))
+            k += 1
+            t = min(t_b + k * signal.step, end_of_signal)
+        else:
+            if t == end_of_signal:
+                chain.set_plate_input(*signal.after)
+            t += settings.chunk
+        if t > reference.t_ref + reference.cycle:
+            return {"phase": phase, "T0": reference.t_ref - t_b, "t_event": math.nan, "advance": math.nan,
+                    "triggered": False, "smaller_events": sum(1 for e in chain.events if e[0] >= t_b)}
+        chain.advance_to(t)
+    t_event = _large(chain, settings, t_b)[0]
+    advance = reference.t_ref - t_event
+    # Smaller events between: slip that released part of the load before the large event.
+    smaller = sum(1 for e in chain.events if t_b <= e[0] < t_event)
+    return {"phase": phase, "T0": reference.t_ref - t_b, "t_event": t_event, "advance": advance,
+            "triggered": bool(advance > 0.0 and t_event <= end_of_signal), "smaller_events": smaller}
+
+
 def clock_advance(reference: Reference, settings: TriggerSettings, phase: float, period: float,
                   acceleration: float) -> dict:
     """One burst of acceleration amplitude ``acceleration`` (delta_0/tau_0^2, g = 1) at
     ``phase`` of the reference cycle: the next large event's start, the clock advance and
     whether the burst triggered it."""
-    amplitude = acceleration * (period / (2.0 * math.pi)) ** 2
+    row = signal_advance(reference, settings, phase,
+                         Burst(acceleration, period, settings.cycles, settings.steps_per_period))
+    return {"phase": phase, "period": period, "acceleration": acceleration, **row}
+
+
+def periodic_advance(reference: Reference, settings: TriggerSettings, phase: float, period: float,
+                     acceleration: float) -> dict:
+    """Periodic loading (:class:`Harmonic`) of acceleration amplitude ``acceleration`` from
+    ``phase`` of the reference cycle on, kept up until the next large event (at most a
+    cycle after the reference one): its start, the clock advance, and whether it came
+    earlier than the reference."""
     t_b = reference.t_s + phase * reference.cycle
-    chain = restored(reference, settings, t_b)
-    step = period / settings.steps_per_period
-    end_of_burst = t_b + settings.cycles * period
-    t, k = t_b, 0
-    while _large(chain, settings, t_b) is None:
-        if t < end_of_burst:
-            chain.set_plate_input(*burst(amplitude, period, settings.cycles, t - t_b))
-            k += 1
-            t = min(t_b + k * step, end_of_burst)
-        else:
-            if t == end_of_burst:
-                chain.set_plate_input(0.0, 0.0, 0.0)
-            t += settings.chunk
-        if t > reference.t_ref + reference.cycle:
-            return {"phase": phase, "period": period, "acceleration": acceleration, "T0": reference.t_ref - t_b,
-                    "t_event": math.nan, "advance": math.nan, "triggered": False}
-        chain.advance_to(t)
-    t_event = _large(chain, settings, t_b)[0]
-    advance = reference.t_ref - t_event
-    return {"phase": phase, "period": period, "acceleration": acceleration, "T0": reference.t_ref - t_b,
-            "t_event": t_event, "advance": advance, "triggered": bool(advance > 0.0 and t_event <= end_of_burst)}
+    harmonic = Harmonic(acceleration, period, reference.t_ref - t_b + reference.cycle, settings.steps_per_period)
+    row = signal_advance(reference, settings, phase, harmonic)
+    return {"phase": phase, "period": period, "acceleration": acceleration, **row}
+
+
+# The chain of the rate-and-state study (examples/chain_rate_state_triggering.py,
+# docs/chain.md): aging law, a = 0.01, b = 0.015 (velocity weakening, b - a = 0.005),
+# D_c = 0.1, V_0 = V_d and theta_0 = D_c / V_d (steady sliding at the loading rate at the
+# start).  Ruina's critical stiffness (b - a) N / D_c = 0.05 N against the loading
+# stiffness of the chain's uniform mode, k_p in series with the contact's k_t,
+# 0.01 * 0.28 / 0.29 = 0.0097: k / k_c = 0.15-0.28 over the spread weights N = m g (1 +/- 0.3),
+# so the chain stick-slips.  No dashpot on the friction spring (the law dissipates by
+# slip).  The blocks differ by their weights (load_spread), the friction law ignoring
+# mu_s.  Its large events peak at slip speeds ~0.4-0.7 and the creep between them
+# and the after-slips stay below ~0.1, so v_start = 0.2 opens only the large events.
+RATE_STATE_STUDY = TriggerSettings(
+    n_blocks=16, mu_s_spread=0.0, load_spread=0.3, seed=1, snapshot_interval=100.0, chunk=25.0,
+    parameters=(("friction_law", 3), ("rs_a", 0.01), ("rs_b", 0.015), ("rs_D_c", 0.1), ("rs_V_0", 1e-2),
+                ("rs_mu_0", 0.5), ("rs_theta_0", 10.0), ("gamma_t", 0.05), ("v_start", 0.2), ("v_stop", 0.05)))

@@ -16,3 +16,16 @@ def test_every_burst_gives_an_advance_no_larger_than_the_time_left():
         assert row["triggered"] == (row["advance"] > 0.0)
     # Above the contact's natural frequency the plate's acceleration does not reach the contact.
     assert rows[0]["advance"] == 0.0 and rows[1]["triggered"]
+
+
+def test_the_chirp_and_the_record_rows_follow_the_reference_at_zero_amplitude():
+    """run_signals: one chirp and one record row per phase and acceleration; at zero
+    amplitude both give the reference event (advance 0), and no advance exceeds T_0."""
+    spec = importlib.util.spec_from_file_location("example_chain_triggering_signals", EXAMPLE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rows = module.run_signals(phases=(0.9,), accelerations=(0.0, 0.2))
+    assert [(r["signal"], r["acceleration"]) for r in rows] == [("chirp", 0.0), ("record", 0.0), ("chirp", 0.2),
+                                                                ("record", 0.2)]
+    assert rows[0]["advance"] == 0.0 and rows[1]["advance"] == 0.0
+    assert all(0.0 <= r["advance"] <= r["T0"] for r in rows)

@@ -14,7 +14,7 @@ from harness.chain.run import simulate_chain
 from harness.cosim.masters import run_libcosim
 from vibroblock.chain import Chain
 
-SETTINGS = {"mu_s_spread": 0.3, "seed": 4, "A": 0.05, "omega": 1.3}
+SETTINGS = {"mu_s_spread": 0.3, "load_spread": 0.2, "seed": 4, "A": 0.05, "omega": 1.3}
 
 
 @pytest.fixture(scope="module")

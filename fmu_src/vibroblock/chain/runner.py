@@ -4,8 +4,8 @@ BlockChain FMU and the harness drive, as ``Block`` is for one block.
 Every block is a model-A block with the single block's laws and scheme,
 ``symplectic_euler`` (default) or ``rk4`` (``chain.kernel``); the chain adds the
 coupling springs k_c between neighbours, a leaf spring k_p (the single block's drive
-spring k_d) per block, per-block mu_s drawn from a seeded distribution, and the event
-catalogue.  Outputs are at the grid point at or
+spring k_d) per block, per-block mu_s and weights drawn from a seeded distribution, and
+the event catalogue.  Outputs are at the grid point at or
 before the requested time (a communication step that is a multiple of dt hits the grid).
 """
 from __future__ import annotations
@@ -38,6 +38,8 @@ CHAIN_PARAMETERS = {
     "v_stop": (0.1, "delta_0/tau_0", "an event closes once every block's slip speed is below this (above the "
                                       "ringing of a block that has stuck again)"),
     "mu_s_spread": (0.0, "1", "heterogeneity: each block's mu_s is mu_s (1 + mu_s_spread u), u uniform in [-1, 1]"),
+    "load_spread": (0.0, "1", "heterogeneity: each block's weight (its normal load) is m g (1 + load_spread u'), u' "
+                              "uniform in [-1, 1], drawn after the mu_s draws"),
     "seed": (0.0, "1", "seed of the heterogeneity's random draw (an integer)"),
 }
 
@@ -118,6 +120,8 @@ class Chain:
                              f"v_start = {p['v_start']!r})")
         if not 0.0 <= p["mu_s_spread"] < 1.0:
             raise ModelError(f"mu_s_spread = {p['mu_s_spread']!r} must be in [0, 1): every mu_s stays positive")
+        if not 0.0 <= p["load_spread"] < 1.0:
+            raise ModelError(f"load_spread = {p['load_spread']!r} must be in [0, 1): every block keeps a weight")
         if p["seed"] != int(p["seed"]) or p["seed"] < 0:
             raise ModelError(f"seed = {p['seed']!r} must be a non-negative integer")
         # The coupling is one more spring on each block: the scheme's stability bound
@@ -137,13 +141,13 @@ class Chain:
         self.settings.check()
         self._check()
         y, self.cnt, self.drv, prm = run_arrays.fresh(self.settings.parameters, t0, self.settings.readings)
-        place(self.settings, prm, self.drv, y)
-        p = self.chain_parameters
         self.Y = np.ascontiguousarray(np.tile(y, (self.n_blocks, 1)))
         self.PRM = np.ascontiguousarray(np.tile(prm, (self.n_blocks, 1)))
-        if p["mu_s_spread"] > 0.0:
-            draw = np.random.default_rng(int(p["seed"])).uniform(-1.0, 1.0, self.n_blocks)
-            self.PRM[:, L.P_MUS] *= 1.0 + p["mu_s_spread"] * draw
+        self.PRM[:, L.P_MUS], self.PRM[:, L.P_G] = self.heterogeneity()
+        # Each block rests at its own weight's penetration, as a single block of that weight would.
+        for i in range(self.n_blocks):
+            place(self.settings, self.PRM[i], self.drv, self.Y[i])
+        p = self.chain_parameters
         self.chn = np.array([p["k_c"], float(self.periodic), p["v_start"], p["v_stop"], float(self.clusters),
                              float(SCHEMES[self.settings.integrator])])
         self.evt = np.zeros(K.N_EVT)
@@ -159,6 +163,23 @@ class Chain:
         self.started = True
         if self.catalog_file is not None:
             self.catalog_file.begin(self.describe_thresholds())
+
+    def heterogeneity(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each block's mu_s and gravity: mu_s (1 + mu_s_spread u_i) and g (1 + load_spread u'_i),
+        u and u' the first and the next n_blocks uniform draws in [-1, 1] of numpy's
+        ``default_rng(seed)``.  Scaling g scales the block's weight m g, its only normal load
+        on model A's flat plate, and leaves its mass, so its inertia, as it is.  A spread of 0
+        leaves the model's value to the bit."""
+        p, n = self.chain_parameters, self.n_blocks
+        rng = np.random.default_rng(int(p["seed"]))
+        mu_s_draw, load_draw = rng.uniform(-1.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
+        mu_s = np.full(n, self.settings.parameters["mu_s"])
+        gravity = np.full(n, self.settings.parameters["g"])
+        if p["mu_s_spread"] > 0.0:
+            mu_s *= 1.0 + p["mu_s_spread"] * mu_s_draw
+        if p["load_spread"] > 0.0:
+            gravity *= 1.0 + p["load_spread"] * load_draw
+        return mu_s, gravity
 
     def set_velocities(self, vx) -> None:
         """Give the blocks these slip velocities at the start (a kick, e.g. along a normal
@@ -220,6 +241,7 @@ class Chain:
     x = property(lambda self: self.Y[:, L.Y_X].copy(), doc="Each block's displacement.")
     vx = property(lambda self: self.Y[:, L.Y_VX].copy(), doc="Each block's slip velocity.")
     mu_s = property(lambda self: self.PRM[:, L.P_MUS].copy(), doc="Each block's static friction coefficient.")
+    gravity = property(lambda self: self.PRM[:, L.P_G].copy(), doc="Each block's g: its weight is m g.")
     grid_time = property(lambda self: float(self.drv[L.D_T0] + self.cnt[L.C_STEP] * self.drv[L.D_DT]))
 
     def plate_height(self) -> float:

@@ -57,6 +57,27 @@ def test_uncoupled_blocks_are_independent_single_blocks_with_their_own_mu_s():
         assert chain.Y[i, :5].tolist() == block.y[:5].tolist()
 
 
+def test_uncoupled_blocks_with_spread_loads_are_single_blocks_of_those_weights():
+    """k_c = 0 and both spreads: each block is Block("A") with its own mu_s and g, bit for
+    bit, on a vibrated plate; a block of the model's weight would sit elsewhere on its
+    contact (the loads reach the contact)."""
+    chain = _chain(3, k_c=0.0, mu_s_spread=0.3, load_spread=0.5, seed=9, **VIBRATED)
+    chain.start()
+    chain.advance_to(1500.0)
+    assert len(set(chain.gravity)) == 3 and not np.any(chain.gravity == 1.0)
+    runs = []
+    for i, (mu_s, gravity) in enumerate(zip(chain.mu_s, chain.gravity)):
+        block = Block("A", "symplectic_euler", 0, False, **{**VIBRATED, "mu_s": float(mu_s), "g": float(gravity)})
+        block.start()
+        block.advance_to(1500.0)
+        assert chain.Y[i, :5].tolist() == block.y[:5].tolist()
+        runs.append(block.y[L.Y_Z])
+    same_load = Block("A", "symplectic_euler", 0, False, **{**VIBRATED, "mu_s": float(chain.mu_s[0])})
+    same_load.start()
+    same_load.advance_to(1500.0)
+    assert same_load.y[L.Y_Z] != runs[0]
+
+
 def _laplacian(n, periodic):
     lap = 2.0 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
     if periodic:

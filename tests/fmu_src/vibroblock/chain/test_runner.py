@@ -11,12 +11,40 @@ from vibroblock.settings import ModelError
     ({"v_start": 0.1, "v_stop": 0.3}, "0 < v_stop <= v_start"),
     ({"k_c": -1.0}, "k_c = -1.0 must be >= 0"),
     ({"mu_s_spread": 1.0}, "every mu_s stays positive"),
+    ({"load_spread": 1.0}, "every block keeps a weight"),
     ({"seed": 1.5}, "non-negative integer"),
     ({"k_c": 1e4}, "too large for the coupling"),
 ])
 def test_settings_that_cannot_run_are_refused_at_the_start(settings, message):
     with pytest.raises(ModelError, match=message):
         Chain(4, **settings).start()
+
+
+def test_the_heterogeneity_is_the_seeded_draw_of_the_documented_distribution():
+    """mu_s (1 + mu_s_spread u_i) and g (1 + load_spread u'_i), u and u' the first and the
+    next N uniform draws in [-1, 1] of default_rng(seed): the same seed gives the same
+    blocks, another seed others, and spreading the loads leaves the mu_s draws as they were."""
+    n = 6
+    chain = Chain(n, mu_s_spread=0.3, load_spread=0.2, seed=11)
+    chain.start()
+    draws = np.random.default_rng(11).uniform(-1.0, 1.0, 2 * n)
+    assert chain.mu_s.tolist() == (0.5 * (1.0 + 0.3 * draws[:n])).tolist()
+    assert chain.gravity.tolist() == (1.0 * (1.0 + 0.2 * draws[n:])).tolist()
+    again, other, mu_s_only = (Chain(n, mu_s_spread=0.3, load_spread=ls, seed=s) for s, ls in ((11, 0.2), (12, 0.2),
+                                                                                              (11, 0.0)))
+    for c in (again, other, mu_s_only):
+        c.start()
+    assert again.gravity.tolist() == chain.gravity.tolist() and again.Y.tolist() == chain.Y.tolist()
+    assert len(set(other.gravity.tolist()) & set(chain.gravity.tolist())) == 0
+    assert mu_s_only.mu_s.tolist() == chain.mu_s.tolist() and set(mu_s_only.gravity.tolist()) == {1.0}
+
+
+def test_each_block_starts_at_rest_under_its_own_weight():
+    """The linear contact's rest penetration is m g_i / k_n for each block's own g_i."""
+    chain = Chain(5, load_spread=0.4, seed=3, A=0.0)
+    chain.start()
+    penetration = chain.plate_height() - chain.Y[:, L.Y_Z]
+    np.testing.assert_allclose(penetration, chain.gravity * 1.0 / 1.0, rtol=1e-12)
 
 
 def test_a_chain_needs_a_block():
