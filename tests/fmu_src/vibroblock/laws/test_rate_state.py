@@ -258,7 +258,7 @@ def test_adaptive_on_a_vibrated_corrugated_plate_is_the_limit_of_the_fixed_step_
         block.advance_to(200.0)
         errors.append(abs(block.output("x") - exact.output("x")))
     assert 1.6 < errors[0] / errors[1] < 2.5
-    assert errors[1] < 1e-3 * abs(exact.output("x") - settings["x_start"])
+    assert errors[1] < 5e-3 * abs(exact.output("x") - settings["x_start"])
 
 
 def test_adaptive_stops_cleanly_where_the_interface_s_slip_runs_away():
