@@ -146,7 +146,7 @@ def block_html(model: str, identifier: str) -> str:
 {_table(("name", "type", "unit", "meaning"), outputs)}
 <p>Any communication step works: the FMU sub-steps on its fixed grid <code>t0 + n dt</code>.
 FMU state get/set and serialization restore a run bit for bit.</p>
-{FMI3_HOST_SECTION if arrays else PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
+{PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
 </body></html>
 """
 
@@ -176,7 +176,7 @@ acceleration integrated exactly, at rest outside the record.</li></ul>
 any format obspy reads (MiniSEED, SAC, GSE2, ..., PEER <code>.AT2</code>), processed at initialization to
 consistent SI motion (response removed with <code>record_inventory</code>, a StationXML, RESP or dataless
 SEED file, for a record in counts); empty for the bundled record.</p>
-{FMI3_HOST_SECTION if arrays else PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
+{PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
 </body></html>
 """
 
