@@ -165,6 +165,10 @@ def test_a_refused_step_returns_fmi3error_and_the_instance_goes_on(chain3):
     assert any("differs from the FMU's time" in text for _, text in chain3.log)
     assert chain3.slave.doStep(0.0, 10.0)[0] is False
     assert chain3.slave.getFloat64([chain3.vr["time"]]) == [10.0]
+    chain3.slave.setUInt64([chain3.vr["N"]], [4])  # fixed once running
+    assert chain3.slave.getUInt64([chain3.vr["N"]]) == [16] and len(chain3.blocks("x")) == 16
+    assert any(status == fmi3Error and "N cannot change during a run" in text for status, text in chain3.log)
+    assert chain3.slave.doStep(10.0, 10.0)[0] is False
 
 
 @pytest.mark.parametrize("serialized", [False, True])
