@@ -181,7 +181,8 @@ SEED file, for a record in counts); empty for the bundled record.</p>
 """
 
 
-CHAIN_SIZES = {False: "Per-block outputs <code>x[i]</code>, <code>vx[i]</code>, i = 1..N, N fixed when the FMU was built.",
+CHAIN_SIZES = {False: "Per-block outputs <code>x[i]</code>, <code>vx[i]</code>, i = 1..N, N fixed when the FMU "
+                      "was built.",
                True: "Per-block outputs: the FMI 3.0 arrays <code>x</code> and <code>vx</code> of size <code>N</code>, "
                      "a structural parameter (UInt64, default 16, 1 to 10000) that a master sets before the other "
                      "settings, in configuration mode or before initialization."}

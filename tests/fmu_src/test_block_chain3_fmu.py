@@ -29,11 +29,12 @@ class Fmi3Chain:
     """One BlockChain3 instance through fmpy's low-level FMI 3 interface, its log kept."""
 
     def __init__(self, fmu: str, folder: str):
-        self.md = read_model_description(fmu)
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.model_description = read_model_description(fmu)
+        self.vr = {v.name: v.valueReference for v in self.model_description.modelVariables}
         self.log = []
-        self.slave = FMU3Slave(guid=self.md.guid, unzipDirectory=extract(fmu, unzipdir=folder),
-                               modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName="chain3")
+        described = self.model_description
+        self.slave = FMU3Slave(guid=described.guid, unzipDirectory=extract(fmu, unzipdir=folder),
+                               modelIdentifier=described.coSimulation.modelIdentifier, instanceName="chain3")
         self.slave.instantiate(logMessage=self._log)
 
     def _log(self, environment, status, category, message):
@@ -47,7 +48,7 @@ class Fmi3Chain:
 
     def set(self, values: dict) -> None:
         for name, value in values.items():
-            kind = next(v.type for v in self.md.modelVariables if v.name == name)
+            kind = next(v.type for v in self.model_description.modelVariables if v.name == name)
             {"Float64": self.slave.setFloat64, "Int32": self.slave.setInt32}[kind]([self.vr[name]], [value])
 
     def initialize(self) -> None:

@@ -35,7 +35,8 @@ class ChainArrayFacade(ChainFacade):
 
     def _register_interface(self) -> None:
         self.register_variable(UInt64(
-            "N", causality=Fmi3Causality.structuralParameter, variability=Fmi3Variability.fixed, initial=Fmi3Initial.exact,
+            "N", causality=Fmi3Causality.structuralParameter, variability=Fmi3Variability.fixed,
+            initial=Fmi3Initial.exact,
             description=f"number of blocks, the size of x and vx (1 ... {MAX_BLOCKS}); set it first: the other "
                         "settings are kept",
             getter=lambda: self.n_blocks, setter=lambda value: self._guard(self._set_n_blocks, value)))
