@@ -2,7 +2,8 @@
 
 One FMU per registered model variant (``vibroblock.models``: ``Block<Name>.fmu``, its
 facade script generated here) and one per FMU script in ``fmu_src`` (``Excitation``,
-``BlockChain``: its number of blocks is fixed here, ``--chain-blocks N``),
+``BlockChain``: its number of blocks is fixed here, ``--chain-blocks N``; ``BlockChain3``,
+the chain as FMI 3.0 co-simulation by pythonfmu3, N a structural parameter defaulting to it),
 FMI 2.0 co-simulation, with the physics core ``fmu_src/vibroblock`` bundled as pythonfmu
 project files.  ``--list`` prints the names; ``--sources`` builds from another source
 tree (e.g. a copy with one more variant).  After pythonfmu has written the archive, finishing steps make it a
@@ -81,11 +82,15 @@ DEFAULT_EXPERIMENT = {"startTime": "0", "stopTime": "100", "stepSize": "0.5"}
 
 
 def complete_model_description(xml_text: bytes) -> bytes:
-    """Add ModelStructure/InitialUnknowns listing every calculated output, and a DefaultExperiment."""
+    """Add ModelStructure/InitialUnknowns listing every calculated output, and a DefaultExperiment.
+    (An FMI 3.0 description gets the DefaultExperiment only: pythonfmu3 writes its structure.)"""
     root = ElementTree.fromstring(xml_text)
     if root.find("DefaultExperiment") is None:
         experiment = ElementTree.Element("DefaultExperiment", DEFAULT_EXPERIMENT)
         root.insert(list(root).index(root.find("ModelVariables")), experiment)
+    if root.get("fmiVersion") == "3.0":
+        ElementTree.indent(root)
+        return ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True)
     variables = root.find("ModelVariables")
     structure = root.find("ModelStructure")
     calculated = [str(index) for index, var in enumerate(variables, start=1)
@@ -137,7 +142,8 @@ def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
             content.update(name.encode())
             content.update(members[name][1])
     root = ElementTree.fromstring(complete_model_description(members["modelDescription.xml"][1]))
-    root.set("guid", "{%s}" % uuid.uuid5(uuid.NAMESPACE_URL, f"vibroblock:{content.hexdigest()}"))
+    token = "guid" if root.get("fmiVersion") == "2.0" else "instantiationToken"
+    root.set(token, "{%s}" % uuid.uuid5(uuid.NAMESPACE_URL, f"vibroblock:{content.hexdigest()}"))
     root.attrib.pop("generationDateAndTime", None)
     item, _ = members["modelDescription.xml"]
     members["modelDescription.xml"] = (item, ElementTree.tostring(root, encoding="UTF-8", xml_declaration=True))
@@ -155,11 +161,20 @@ def finish_archive(fmu: Path, extra: dict[str, bytes] | None = None) -> None:
     tmp_path.replace(fmu)
 
 
-def chain_script(n_blocks: int) -> str:
-    """The BlockChain FMU script with its number of blocks set to ``n_blocks``."""
+CHAIN_FMUS = ("BlockChain", "BlockChain3")
+# pythonfmu3's loader finds the slave class by this text (as pythonfmu's by "(Fmi2Slave):").
+FMI3_MARK = "(Fmi3Slave):"
+# What pythonfmu3 0.3.4 would write wrongly: it gives every co-simulation flag the value
+# of its last common one (fmi3slave.py, Fmi3SlaveBase.to_xml).
+FMI3_OPTIONS = {"canGetAndSetFMUState": True, "canSerializeFMUState": True,
+                "canHandleVariableCommunicationStepSize": True}
+
+
+def chain_script(n_blocks: int, name: str = "BlockChain") -> str:
+    """A chain FMU script with its number of blocks (the default N of BlockChain3) set to ``n_blocks``."""
     if n_blocks < 1:
         raise SystemExit(f"--chain-blocks {n_blocks}: a chain has at least one block")
-    text = (SOURCES / "BlockChain.py").read_text()
+    text = (SOURCES / f"{name}.py").read_text()
     default = "\nN_BLOCKS = "
     start = text.index(default) + len(default)
     return text[:start] + str(int(n_blocks)) + text[text.index("\n", start):]
@@ -170,7 +185,7 @@ def build(name: str, dest: Path, ship_kernels: bool = True, chain_blocks: int | 
 
     generated = variant_scripts()
     if chain_blocks is not None:
-        generated["BlockChain"] = chain_script(chain_blocks)
+        generated.update({chain: chain_script(chain_blocks, chain) for chain in CHAIN_FMUS})
     with tempfile.TemporaryDirectory() as scratch:
         script = SOURCES / f"{name}.py"
         if name in generated:
@@ -183,18 +198,36 @@ def build(name: str, dest: Path, ship_kernels: bool = True, chain_blocks: int | 
             records = Path(scratch) / "vibroblock_records"
             shutil.copytree(RECORDS, records, ignore=shutil.ignore_patterns("__pycache__"))
             project_files.append(records)
-        fmu = FmuBuilder.build_FMU(script, dest=dest, project_files=project_files,
-                                   canGetAndSetFMUstate=True, canSerializeFMUstate=True)
-    fmu = Path(fmu)
-    from status_shim import wrap_fmu
-    wrap_fmu(fmu)
+        fmi3 = FMI3_MARK in script.read_text()
+        if fmi3:
+            fmu = Path(build_fmi3(script, dest, project_files, Path(scratch)))
+        else:
+            fmu = Path(FmuBuilder.build_FMU(script, dest=dest, project_files=project_files,
+                                            canGetAndSetFMUstate=True, canSerializeFMUstate=True))
     import documentation
-    extra = {PYTHON_ENVIRONMENT: python_environment_record(), **documentation.archive_members(name)}
-    if name.startswith("Block") and ship_kernels:  # the variants' and BlockChain ("Chain")
+    extra = documentation.archive_members(name)
+    if not fmi3:  # the status shim and its Python environment record are FMI 2.0 code
+        from status_shim import wrap_fmu
+        wrap_fmu(fmu)
+        extra[PYTHON_ENVIRONMENT] = python_environment_record()
+    if name.startswith("Block") and ship_kernels:  # the variants' and the chains' ("Chain")
         import kernels
-        extra.update(kernels.archive_members(CORE, name[len("Block"):]))
+        extra.update(kernels.archive_members(CORE, "Chain" if name in CHAIN_FMUS else name[len("Block"):]))
     finish_archive(fmu, extra)
     return fmu
+
+
+def build_fmi3(script: Path, dest: Path, project_files: list, scratch: Path) -> Path:
+    """An FMI 3.0 FMU by pythonfmu3.  Its facades are FMI 2.0 facades behind an adapter
+    (vibroblock/fmi3.py), so the FMU bundles pythonfmu's Python modules too (pythonfmu3
+    bundles its own)."""
+    import pythonfmu
+    from pythonfmu3 import FmuBuilder as Fmi3Builder
+
+    bundled = scratch / "pythonfmu"
+    shutil.copytree(Path(pythonfmu.__file__).parent, bundled,
+                    ignore=shutil.ignore_patterns("__pycache__", "resources", "pythonfmu-export", "tests"))
+    return Fmi3Builder.build_FMU(script, dest=dest, project_files=[*project_files, bundled], **FMI3_OPTIONS)
 
 
 def main(argv=None) -> int:

@@ -181,7 +181,20 @@ SEED file, for a record in counts); empty for the bundled record.</p>
 """
 
 
-def chain_html(identifier: str) -> str:
+CHAIN_SIZES = {False: "Per-block outputs <code>x[i]</code>, <code>vx[i]</code>, i = 1..N, N fixed when the FMU "
+                      "was built.",
+               True: "Per-block outputs: the FMI 3.0 arrays <code>x</code> and <code>vx</code> of size <code>N</code>, "
+                     "a structural parameter (UInt64, default 16, 1 to 10000) that a master sets before the other "
+                     "settings, in configuration mode or before initialization."}
+FMI3_HOST_SECTION = """<h2>Host</h2>
+<p>pythonfmu3's native library runs the model in the host process's own Python, which must offer
+numpy, numba and pythonfmu (fmpy started from the environment the FMU was built with does). A
+refused setting is logged with status fmi3Error; pythonfmu3 returns fmi3OK from setters, so the FMU
+then refuses to initialize and every doStep returns fmi3Error. The start time is 0: pythonfmu3 does
+not pass fmi3EnterInitializationMode's start time on, and a doStep from another time is refused.</p>"""
+
+
+def chain_html(identifier: str, arrays: bool = False) -> str:
     from vibroblock.chain.runner import BLOCK_DEFAULTS, CHAIN_PARAMETERS, chain_defaults
     from vibroblock.chain.slave import AGGREGATES, BLOCK_PARAMETERS, CATALOG_TEXT
     from vibroblock.models import defaults, parameters_for
@@ -198,13 +211,13 @@ def chain_html(identifier: str) -> str:
 <p>N blocks in a row (Burridge-Knopoff), each a model-A block with the single block's contact and
 friction laws and its symplectic Euler step; a leaf spring <code>k_p</code> pulls each towards the
 loader at <code>V_d t</code>, springs <code>k_c</code> couple neighbours (free or periodic ends).
-Per-block outputs <code>x[i]</code>, <code>vx[i]</code>, i = 1..N, N fixed when the FMU was built.</p>
+{CHAIN_SIZES[arrays]}</p>
 <h2>Parameters</h2>
 {_table(("name", "unit", "default", "meaning"), rows)}
 <p><code>catalog_file</code> (String): {_e(CATALOG_TEXT)}.</p>
 <h2>Outputs</h2>
 {_table(("name", "unit", "meaning"), outputs)}
-{PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
+{FMI3_HOST_SECTION if arrays else PYTHON_SECTION.replace("{env}", ENV_VARIABLE)}
 </body></html>
 """
 
@@ -245,9 +258,9 @@ def icon_png(model: str | None) -> bytes:
 
 def archive_members(name: str) -> dict[str, bytes]:
     """``documentation/index.html`` and ``model.png`` for the FMU ``name``."""
-    if name == "BlockChain":
+    if name in ("BlockChain", "BlockChain3"):
         model = "A"
-        page = chain_html(name)
+        page = chain_html(name, arrays=name == "BlockChain3")
     elif name.startswith("Block"):
         model = name[len("Block"):]
         page = block_html(model, name)

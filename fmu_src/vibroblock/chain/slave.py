@@ -113,6 +113,10 @@ class ChainFacade(PlateInputs, FmuFacade):
                 variability=Fmi2Variability.continuous if kind == "Real" else Fmi2Variability.discrete,
                 description=f"{text} [{unit}]" if unit else text,
                 getter=lambda name=name: self._output(name)))
+        self._register_per_block_outputs()
+
+    def _register_per_block_outputs(self) -> None:
+        """FMI 2.0 has no arrays: one scalar per block and output, x[1] ... x[N]."""
         for name, text in PER_BLOCK.items():
             for i in range(self.n_blocks):
                 self.register_variable(Real(
