@@ -31,11 +31,22 @@ from harness.runs.settings import Integration, PointSettings, RunSettings, canon
 from harness.runs.store import write_json_atomically
 from harness.runs.sweep import OBSERVABLES_VERSION, Execution, Grid, map_with_pool, run_sweep
 
+from vibroblock.laws import law
+
 from .readings import DEFAULT_READING, Reading
 
 
 # Model A's integrator in the studies where it applies (see Runner.run).
 MODEL_A_INTEGRATOR = "event_driven"
+def exact_flows_apply(parameters: dict) -> bool:
+    """Whether ``event_driven``'s closed forms run model A under these parameters: the
+    contact-force bound, and a contact law the registry calls linear (the no-pull
+    contact's clipped force is not)."""
+    if parameters.get("coulomb_normal"):
+        return False
+    return bool(getattr(law("contact", int(parameters.get("contact_law", 0))).module, "LINEAR", False))
+
+
 # Models B and C: ``adaptive`` where it is the cheaper one, the paper's scheme elsewhere
 # (see Runner.run), with the adaptive integrator's tolerances.
 CORRUGATED_INTEGRATION = Integration("adaptive", switch=(("omega", 20.0), ("plate_speed", 16.0), ("V_d", 1.0)),
@@ -165,7 +176,8 @@ class Runner:
         Without an ``integration`` of the study's own, model A runs with ``event_driven``
         (exact flows with located events, cheaper and more accurate than the paper's
         first-order scheme through the FMU: docs/benchmarks.md) where
-        it applies, i.e. under the contact-force bound, else with the paper's
+        it applies, i.e. under the contact-force bound and a contact law linear in the
+        penetration and its rate (``exact_flows_apply``), else with the paper's
         ``symplectic_euler`` at dt = 4e-4.  Models B and C run with ``adaptive`` (rtol
         1e-6, atol 1e-8) at omega <= 20, A omega <= 16 and V_d <= 1, ``symplectic_euler``
         otherwise: the paper's scheme costs the same at every omega and A (its step is
@@ -178,7 +190,7 @@ class Runner:
         scheme: there the two disagree on the regime and no reference decides between them."""
         parameters = {**self.reading.parameters(model), **dict(fields.pop("parameters", {}) or {})}
         if "integration" not in fields:
-            if model == "A" and not parameters.get("coulomb_normal"):
+            if model == "A" and exact_flows_apply(parameters):
                 fields["integration"] = Integration(MODEL_A_INTEGRATOR)
             elif model in "BC":
                 fields["integration"] = CORRUGATED_INTEGRATION

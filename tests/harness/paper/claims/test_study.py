@@ -1,6 +1,7 @@
 """The studies' runner: which integrator each model's runs take."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from harness.paper.claims import Runner
@@ -21,6 +22,20 @@ def test_model_a_runs_exactly_where_the_event_driven_scheme_applies(runner):
     assert runner.run("A", parameters={"coulomb_normal": 1.0}).integration == Integration("symplectic_euler")
     runner.reading = Reading(coulomb_normal=1)
     assert runner.run("A").integration == Integration("symplectic_euler")
+
+
+@pytest.mark.parametrize("contact_law, exact", [(1, True), (2, False)])
+def test_model_a_keeps_the_exact_flows_only_under_a_linear_contact_law(runner, fmu_dir, contact_law, exact):
+    """The law readings (--laws): the contact along the normal is linear (exact flows); the
+    no-pull contact is clipped, which event_driven refuses, so its runs take Euler, and
+    the FMU accepts the run the runner chose."""
+    from harness.runs.run import simulate
+
+    runner.reading = Reading(contact_law=contact_law)
+    run = runner.run("A", horizon=1.0)
+    assert run.integration == Integration("event_driven" if exact else "symplectic_euler")
+    trajectory = simulate(run, outputs=("x",))  # initialized and ran (event_driven would refuse the no-pull law)
+    assert trajectory["x"].size == 2 and np.all(np.isfinite(trajectory["x"].values))
 
 
 def test_a_study_s_own_integration_is_left_alone(runner):
