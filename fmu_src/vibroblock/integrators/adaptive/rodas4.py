@@ -52,58 +52,70 @@ EPS = 2.220446049250313e-16
 JAC_STEP = 1e-5  # relative increment of the central differences (~eps^(1/3))
 
 
-@njit(inline="always")
-def _factor(jac, c, lu, piv):
-    """LU (partial pivoting) of c I - J on the state block; False if singular."""
-    for i in range(NS):
-        for j in range(NS):
-            lu[i, j] = -jac[i, j]
-        lu[i, i] += c
-    for k in range(NS):
-        p = k
-        best = abs(lu[k, k])
-        for i in range(k + 1, NS):
-            if abs(lu[i, k]) > best:
-                best, p = abs(lu[i, k]), i
-        piv[k] = p
-        if best == 0.0 or not math.isfinite(best):
-            return False
-        if p != k:
-            for j in range(NS):
-                lu[k, j], lu[p, j] = lu[p, j], lu[k, j]
-        inv = 1.0 / lu[k, k]
-        for i in range(k + 1, NS):
-            lu[i, k] *= inv
-            f = lu[i, k]
-            for j in range(k + 1, NS):
-                lu[i, j] -= f * lu[k, j]
-    return True
+def _factor_of(n):
+    """LU (partial pivoting) of c I - J on the first n state components; False if singular."""
+    @njit(inline="always")
+    def factor(jac, c, lu, piv):
+        for i in range(n):
+            for j in range(n):
+                lu[i, j] = -jac[i, j]
+            lu[i, i] += c
+        for k in range(n):
+            p = k
+            best = abs(lu[k, k])
+            for i in range(k + 1, n):
+                if abs(lu[i, k]) > best:
+                    best, p = abs(lu[i, k]), i
+            piv[k] = p
+            if best == 0.0 or not math.isfinite(best):
+                return False
+            if p != k:
+                for j in range(n):
+                    lu[k, j], lu[p, j] = lu[p, j], lu[k, j]
+            inv = 1.0 / lu[k, k]
+            for i in range(k + 1, n):
+                lu[i, k] *= inv
+                f = lu[i, k]
+                for j in range(k + 1, n):
+                    lu[i, j] -= f * lu[k, j]
+        return True
+    return factor
 
 
-@njit(inline="always")
-def _solve(jac, c, lu, piv, r):
-    """Solve (c I - J) k = r in place; the quadrature rows follow from the state's
-    (their columns of J are zero).  ``_factor`` swaps whole rows, multipliers included,
-    so r takes all the interchanges before the forward substitution (interleaving them
-    would pair a row's value with another row's multipliers after a later swap)."""
-    for k in range(NS):
-        p = piv[k]
-        if p != k:
-            r[k], r[p] = r[p], r[k]
-    for k in range(NS):
-        for i in range(k + 1, NS):
-            r[i] -= lu[i, k] * r[k]
-    for k in range(NS - 1, -1, -1):
-        s = r[k]
-        for j in range(k + 1, NS):
-            s -= lu[k, j] * r[j]
-        r[k] = s / lu[k, k]
-    inv_c = 1.0 / c
-    for i in range(NS, NV):
-        s = r[i]
-        for j in range(NS):
-            s += jac[i, j] * r[j]
-        r[i] = s * inv_c
+def _solve_of(n):
+    """Solve (c I - J) k = r in place on the first n state components; the quadrature rows
+    follow from the state's (their columns of J are zero).  ``factor`` swaps whole rows,
+    multipliers included, so r takes all the interchanges before the forward substitution
+    (interleaving them would pair a row's value with another row's multipliers after a
+    later swap)."""
+    @njit(inline="always")
+    def solve(jac, c, lu, piv, r):
+        for k in range(n):
+            p = piv[k]
+            if p != k:
+                r[k], r[p] = r[p], r[k]
+        for k in range(n):
+            for i in range(k + 1, n):
+                r[i] -= lu[i, k] * r[k]
+        for k in range(n - 1, -1, -1):
+            s = r[k]
+            for j in range(k + 1, n):
+                s -= lu[k, j] * r[j]
+            r[k] = s / lu[k, k]
+        inv_c = 1.0 / c
+        for i in range(NS, NV):
+            s = r[i]
+            for j in range(n):
+                s += jac[i, j] * r[j]
+            r[i] = s * inv_c
+    return solve
+
+
+# Where theta does not move (the laws without an interface slip) its row and column of
+# c I - J are c and 0 and its rates 0, so its stage values stay 0: the factorisation and
+# the solves run on the five mechanical components alone, at their cost without theta.
+_factor_motion, _factor_all = _factor_of(NS_MOTION), _factor_of(NS)
+_solve_motion, _solve_all = _solve_of(NS_MOTION), _solve_of(NS)
 
 
 # linearise and rosenbrock are compiled functions of their own, called rather than inlined
@@ -158,7 +170,8 @@ def rosenbrock(system, clk, v, t_abs, u, h, ws, out):
     prm = system[3]
     f0, ft, stage, rate, k = rows[F0], rows[FT], rows[STAGE], rows[RATE], rows[K:K + 6]
     c = 1.0 / (h * GAMMA)
-    if not _factor(jac, c, lu, piv):
+    slips = friction_interface_slips(system[0])
+    if not (_factor_all(jac, c, lu, piv) if slips else _factor_motion(jac, c, lu, piv)):
         return math.inf
     for s in range(6):
         if s == 0:
@@ -177,7 +190,10 @@ def rosenbrock(system, clk, v, t_abs, u, h, ws, out):
             for j in range(s):
                 acc += STAGE_CC[s, j] * inv_h * k[j, i]
             k[s, i] = acc
-        _solve(jac, c, lu, piv, k[s])
+        if slips:
+            _solve_all(jac, c, lu, piv, k[s])
+        else:
+            _solve_motion(jac, c, lu, piv, k[s])
     err = 0.0
     for i in range(NV):
         out[i] = stage[i] + k[5, i]  # stiffly accurate: the last stage's argument plus k6
