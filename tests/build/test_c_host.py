@@ -241,7 +241,10 @@ BY_NAME = {"BlockA": {"integrator": "rk4", "contact_law": "hertz_hunt_crossley",
                       "rs_theta_0": 100.0},
            "BlockB": {"integrator": "symplectic_euler", "formulation": "tangent_frame", "friction_law": "rate_state_slip",
                       "contact_law": "linear_no_pull", "k_d": 0.1, "V_d": 0.5, "A": 0.5, "omega": 0.8,
-                      "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0}}
+                      "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0},
+           "BlockC": {"integrator": "adaptive", "friction_law": "rate_state_aging", "coulomb_normal": "applied_load",
+                      "contact_law": "linear_along_normal", "k_d": 0.1, "V_d": 0.5, "A": 0.5, "omega": 0.8,
+                      "rs_D_c": 1.0, "rs_V_0": 1e-3, "rs_theta_0": 1000.0}}
 
 
 def by_name_args(settings):
