@@ -146,7 +146,9 @@ def bound(kind, v, t, pz, pv, prm):
     """Penetration and the Coulomb bound mu_s N at time t: N the contact force continued
     across delta = 0, or the applied load at the block's x and t (``coulomb_bound``)."""
     pen, u_n, u_t, cos_a, sin_a, normal = surface_contact(kind, v[0], v[1], v[2], v[3], pz, pv, prm)
-    return pen, prm[P_MUS] * coulomb_bound(kind, contact_force(kind, pen, u_n, prm), v[0], t, prm)
+    normal_bound = coulomb_bound(kind, contact_force(kind, pen, u_n, prm), v[0], t, prm)
+    # A slipping interface has no Coulomb bound (mu_s plays no part): its regimes turn on N_b's sign alone.
+    return pen, normal_bound if friction_interface_slips(kind) else prm[P_MUS] * normal_bound
 
 
 @njit(inline="always")

@@ -315,3 +315,18 @@ def test_theta_is_state_restored_with_the_run(integrator):
     block.set_state(saved)
     block.advance_to(1500.0)
     assert block.outputs() == first
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "adaptive"])
+def test_mu_s_plays_no_part_under_rate_and_state(integrator):
+    """The interface's coefficient is mu(V, theta): a run with mu_s = 0 (no Coulomb bound)
+    is the run with the default mu_s, bit for bit, in both the fixed-step rule and
+    adaptive's regimes (which turn on N_b's sign, not on mu_s N_b)."""
+    runs = []
+    for mu_s in (0.5, 0.0):
+        block = Block("C", integrator, 0, False, dt=1e-2, friction_law="rate_state_aging", k_d=1e-2, V_d=1e-2,
+                      A=0.2, omega=0.5, mu_s=mu_s, rs_D_c=1.0, rs_V_0=V0, rs_theta_0=1.0 / V0)
+        block.start()
+        block.advance_to(100.0)
+        runs.append(block.y.copy())
+    assert abs(runs[0][L.Y_F]) > 0.0 and runs[0].tobytes() == runs[1].tobytes()
