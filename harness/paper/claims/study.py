@@ -31,7 +31,7 @@ from harness.runs.settings import Integration, PointSettings, RunSettings, canon
 from harness.runs.store import write_json_atomically
 from harness.runs.sweep import OBSERVABLES_VERSION, Execution, Grid, map_with_pool, run_sweep
 
-from vibroblock.laws import law
+from vibroblock.integrators import INTEGRATOR_RECORDS
 
 from .readings import DEFAULT_READING, Reading
 
@@ -39,12 +39,12 @@ from .readings import DEFAULT_READING, Reading
 # Model A's integrator in the studies where it applies (see Runner.run).
 MODEL_A_INTEGRATOR = "event_driven"
 def exact_flows_apply(parameters: dict) -> bool:
-    """Whether ``event_driven``'s closed forms run model A under these parameters: the
-    contact-force bound, and a contact law the registry calls linear (the no-pull
+    """Whether ``event_driven``'s closed forms run model A under these parameters, as its
+    registry record decides (the contact-force bound and a linear contact law: the no-pull
     contact's clipped force is not)."""
-    if parameters.get("coulomb_normal"):
-        return False
-    return bool(getattr(law("contact", int(parameters.get("contact_law", 0))).module, "LINEAR", False))
+    readings = {"coulomb_normal": int(parameters.get("coulomb_normal", 0)),
+                "contact_law": int(parameters.get("contact_law", 0))}
+    return INTEGRATOR_RECORDS["event_driven"].unsupported_reading(readings) is None
 
 
 # Models B and C: ``adaptive`` where it is the cheaper one, the paper's scheme elsewhere
