@@ -11,7 +11,7 @@ them alive for the whole call.
 from __future__ import annotations
 
 from . import jitcache  # noqa: F401  (before numba: the kernel cache's folder and locator)
-from numba import types  # noqa: E402
+from numba import carray, njit, types  # noqa: E402
 from numba.extending import intrinsic  # noqa: E402
 
 
@@ -44,3 +44,33 @@ def row_pointer(typingctx, array, row):
         return builder.gep(data.data, [builder.mul(index, columns)])
 
     return types.CPointer(array.dtype)(array, row), codegen
+
+
+@intrinsic
+def _data_of(typingctx, array):
+    """The data of a C-contiguous array of any rank as a ``CPointer`` of its element type."""
+    if not (isinstance(array, types.Array) and array.layout == "C"):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return context.make_array(array)(context, builder, value=args[0]).data
+
+    return types.CPointer(array.dtype)(array), codegen
+
+
+@njit(inline="always")
+def unowned(array):
+    """A view of ``array`` (C-contiguous, any rank) that numba does not count: its views and
+    the calls it is passed to take no atomic reference counts.  The caller keeps ``array``
+    alive (``keep_alive``) for as long as the view is used."""
+    return carray(_data_of(array), array.shape)
+
+
+@intrinsic
+def keep_alive(typingctx, owner):
+    """A use of ``owner`` that emits no code: numba frees an array after its last use, so an
+    array read through an ``unowned`` view must be used again after the view's last read."""
+    def codegen(context, builder, signature, args):
+        return context.get_dummy_value()
+
+    return types.none(owner), codegen

@@ -4,7 +4,7 @@ import pytest
 from numba import njit
 from numba.core.errors import TypingError
 
-from vibroblock.unowned import data_pointer, row_pointer
+from vibroblock.unowned import data_pointer, keep_alive, row_pointer, unowned
 
 
 @njit
@@ -53,3 +53,31 @@ def test_a_row_pointer_reaches_that_row_and_no_other():
 def test_a_row_pointer_of_a_transposed_table_is_refused():
     with pytest.raises(TypingError):
         _bump_row(np.arange(12.0).reshape(3, 4).T, 0)
+
+
+@njit
+def _fill_through_views(rows, columns):
+    """Allocates a table, writes it through an unowned view's row views, returns the owner."""
+    owner = np.zeros((rows, columns))
+    table = unowned(owner)
+    for r in range(rows):
+        row = table[r]  # a view of the unowned view: no reference count taken
+        for c in range(columns):
+            row[c] = 10.0 * r + c
+    keep_alive(owner)
+    return owner
+
+
+def test_an_unowned_view_reads_and_writes_its_owners_data():
+    assert _fill_through_views(3, 4).tolist() == [[10.0 * r + c for c in range(4)] for r in range(3)]
+
+
+@njit
+def _unowned_first(values):
+    return unowned(values)[0, 0]
+
+
+def test_an_unowned_view_of_a_strided_array_is_refused_at_compile_time():
+    """Its data pointer would read the base array's elements, not the view's."""
+    with pytest.raises(TypingError):
+        _unowned_first(np.arange(12.0).reshape(3, 4)[:, ::2])

@@ -18,7 +18,7 @@ from numba import njit
 
 from ...dynamics import contact
 from ...laws import friction_energy, friction_integrated, friction_interface_slips, friction_spring_force, friction_stored
-from ...unowned import data_pointer
+from ...unowned import data_pointer, keep_alive, unowned
 from ...layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
                        D_EXT_A, D_EXT_V, D_EXT_Z, D_OMEGA, D_T0, N_OBS, P_MAX_JUMP, P_RTOL, Y_DISSIPATED,
                        Y_E_NORMAL, Y_F, Y_FRICTION_STATE, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
@@ -221,11 +221,10 @@ def _try_jump(run, v, acc, ic, tm, clk, ws):
     was, bit for bit).  Returns OK or NON_FINITE."""
     drv = run[1]
     u = tm[T_U]
-    try_clk = np.empty(2)
+    owned = (np.empty(2), np.zeros(4, dtype=np.int64), np.zeros(4))
+    try_clk, tally, dq = unowned(owned[0]), unowned(owned[1]), unowned(owned[2])
     try_clk[0], try_clk[1] = clk[0], clk[1]
     advance_clock(drv, try_clk, u, False)
-    tally = np.zeros(4, dtype=np.int64)
-    dq = np.zeros(4)
     plan = (tm[T_PERIOD], tm[T_CAP], tm[T_H], ic[I_EXPLICIT] != 0)
     u_jumped = stroboscopic(_system(run, ic), v, tm[T_BASE] + u, try_clk, tm[T_END] - u, plan, dq, tally, ws)
     ic[I_ACCEPTED] += tally[0]
@@ -244,13 +243,14 @@ def _try_jump(run, v, acc, ic, tm, clk, ws):
         acc[A_DISSIPATED] += dq[2]
         acc[A_E_NORMAL] += dq[3]
         ic[I_STROBE_WAIT] = STROBE_WAIT
-        if not _finite(v):
-            return NON_FINITE
+        status = OK if _finite(v) else NON_FINITE
     else:
+        status = OK
         ic[I_STROBE_WAIT] = min(2 * ic[I_STROBE_WAIT], STROBE_WAIT_MAX)
         ic[I_REFUSED] += STROBE_TRY
     tm[T_STROBE_NEXT] = tm[T_U] + ic[I_STROBE_WAIT] * tm[T_PERIOD]
-    return OK
+    keep_alive(owned)
+    return status
 
 
 @njit(inline="always")
@@ -447,9 +447,14 @@ def evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     rejected, events, Jacobians, periods jumped) to costs[1:6].  Returns OK or a negative status."""
     drv, prm = data_pointer(drv), data_pointer(prm)
     run = (kind, drv, prm, track_energy)
-    clk = clock(drv, cnt, n0)
-    ws = workspace()
-    v, acc, ic, tm = _start(run, y, cnt, n0, u_end, clk, ws)
+    owned_clock = clock(drv, cnt, n0)
+    clk = unowned(owned_clock)
+    # The loop reads its scratch and state through unowned views: every view taken of a
+    # counted array costs two atomic operations, a quarter of a step's time.
+    owned = workspace()
+    ws = (unowned(owned[0]), unowned(owned[1]), unowned(owned[2]), unowned(owned[3]))
+    state = _start(run, y, cnt, n0, u_end, clk, ws)
+    v, acc, ic, tm = unowned(state[0]), unowned(state[1]), unowned(state[2]), unowned(state[3])
     status = OK
     while tm[T_U] < tm[T_END]:
         if ic[I_ACCEPTED] + ic[I_REJECTED] >= MAX_STEPS:
@@ -476,6 +481,7 @@ def evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     out[Y_WORK], out[Y_DISSIPATED], out[Y_E_NORMAL] = acc[A_WORK], acc[A_DISSIPATED], acc[A_E_NORMAL]
     for i in range(N_COSTS):
         costs[i] = ic[i]
+    keep_alive((owned, state, owned_clock))
     return status
 
 

@@ -41,6 +41,7 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...layout import P_ATOL, P_KD, P_MAX_JUMP, P_RTOL, P_VD
+from ...unowned import keep_alive, unowned
 from .methods import EVENT_SAMPLES, growth, sample_state, shrink, step
 from .regimes import NS, NS_MOTION, NV, THETA, event_at, event_value, events_of, plate, rates, switch_values
 from .rodas4 import EPS, linearise
@@ -375,6 +376,17 @@ def _land(sw, v, dq, count, n_events):
 
 @njit(cache=True)
 def stroboscopic(system, v, t_base, clk, u_end, plan, dq, tally, ws):
+    """``jump_periods`` with its scratch allocated here and read through unowned views
+    (a counted view costs two atomic operations, and the jumps take many)."""
+    owned = (np.empty(STROBE_STEPS), np.zeros((STROBE_ROWS, NA)), np.zeros((3, NA, NA)), np.empty(2))
+    scratch = (unowned(owned[0]), unowned(owned[1]), unowned(owned[2]), unowned(owned[3]))
+    jumped = jump_periods(system, v, t_base, clk, u_end, plan, (dq, tally, ws), scratch)
+    keep_alive(owned)
+    return jumped
+
+
+@njit
+def jump_periods(system, v, t_base, clk, u_end, plan, shared, scratch):
     """Take the plate periods from the clock's origin (time t_base) K at a time while the
     block stays in its regime (LOADED) without a switch (the module's doc), up to local
     time u_end; ``plan`` is (period, cap, first step, explicit).  Moves v (state slots) and
@@ -382,10 +394,8 @@ def stroboscopic(system, v, t_base, clk, u_end, plan, dq, tally, ws):
     tally (accepted, rejected, Jacobians, periods jumped) the costs."""
     prm, period = system[3], plan[0]
     n_events = events_of(system[0], system[1])[1]
-    hs = np.empty(STROBE_STEPS)
-    sw = np.zeros((STROBE_ROWS, NA))
-    mats = np.zeros((3, NA, NA))
-    at = np.empty(2)  # the clock of a replayed period's start
+    dq, tally, ws = shared
+    hs, sw, mats, at = scratch  # at: the clock of a replayed period's start
     for i in range(4):
         dq[i] = 0.0
     for i in range(NS):
