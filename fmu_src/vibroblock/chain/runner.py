@@ -35,6 +35,7 @@ GRID_TOLERANCE = 1e-6
 # stiffest spring (rk4's as the single block's check asks).
 SCHEMES = {"symplectic_euler": K.SYMPLECTIC_EULER, "rk4": K.RK4}
 STABLE = {"symplectic_euler": 1.0, "rk4": 4.0}
+LAB_SLOTS = {"x": (L.Y_X, 0), "vx": (L.Y_VX, 1)}  # an output's state slot and its part of kernel.lab_offset
 CATALOG_ROWS = 4096  # rows the kernel fills before the runner empties them
 # The chain's own parameters: name -> (default, unit, description).  The blocks'
 # parameters are model A's, with the drive spring k_d called k_p (the leaf spring).
@@ -251,13 +252,19 @@ class Chain:
     slip_velocity = property(lambda self: self.Y[:, L.Y_VX].copy(),
                              doc="Each block's velocity relative to the plate (vx under vertical shaking).")
 
-    def _lab(self, slot: int, which: int) -> np.ndarray:
-        """The blocks' slot ``slot`` in the lab: the plate frame's plus the plate's position
-        (which = 0) or velocity (1) under the oblique plate law (``kernel.lab_offset``)."""
-        values = self.Y[:, slot].copy()
+    def _lab(self, slot: int, which: int, block: int | None = None):
+        """The blocks' slot ``slot`` in the lab (of one ``block``, else of all): the plate
+        frame's plus the plate's position (which = 0) or velocity (1) under the oblique
+        plate law (``kernel.lab_offset``)."""
+        values = self.Y[:, slot].copy() if block is None else float(self.Y[block, slot])
         if run_arrays.plate_law(self.settings.readings).SIDEWAYS:
             values += K.lab_offset(self.settings.kind, self.drv, self.cnt)[which]
         return values
+
+    def lab(self, name: str, block: int) -> float:
+        """One block's ``x`` or ``vx`` in the lab, as ``Chain.x[block]`` (an FMU's scalar
+        output reads one block without copying all)."""
+        return self._lab(*LAB_SLOTS[name], block)
     mu_s = property(lambda self: self.PRM[:, L.P_MUS].copy(), doc="Each block's static friction coefficient.")
     gravity = property(lambda self: self.PRM[:, L.P_G].copy(), doc="Each block's g: its weight is m g.")
     grid_time = property(lambda self: float(self.drv[L.D_T0] + self.cnt[L.C_STEP] * self.drv[L.D_DT]))

@@ -176,7 +176,7 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _block_output(self, name: str, i: int) -> float:
         if not self.chain.started:
             return 0.0
-        return float(getattr(self.chain, name)[i])  # (the lab's: Chain.x, Chain.vx)
+        return self.chain.lab(name, i)
 
     # ------------------------------------------------------------------ facade hooks
     def _is_started(self) -> bool:
