@@ -109,3 +109,94 @@ def test_libcosim_gives_fmpys_bits(chain_fmu, tmp_path):
     fmpy = simulate_fmu(chain_fmu, stop_time=3000.0, output_interval=50.0, start_values=SETTINGS, output=outputs)
     for name in outputs:
         np.testing.assert_array_equal(np.asarray(cosim[name], dtype=float), fmpy[name].astype(float))
+
+
+HORIZONTAL_DRIVE = {"A": 0.05, "omega": 0.3, "drive_angle": float(np.pi / 2)}
+
+
+def _shaken_run(slave, vr, amplitude, step, stop=60.0):
+    """Run the instance on a horizontally shaken plate (rk4): by its own drive at
+    ``amplitude``, else (amplitude 0) by the inputs plate_x, plate_vx, plate_ax, the drive's
+    values sampled at each communication point and held over the step.  Returns x[1],
+    x[16], vx[16] at the communication points."""
+    slave.setInteger([vr["plate_motion"], vr["integrator"]], [1, 1])
+    slave.setReal([vr[name] for name in HORIZONTAL_DRIVE], [*HORIZONTAL_DRIVE.values()])
+    slave.setReal([vr["A"]], [amplitude])
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    a, w = HORIZONTAL_DRIVE["A"], HORIZONTAL_DRIVE["omega"]
+    rows, outputs = [], [vr["x[1]"], vr["x[16]"], vr["vx[16]"]]
+    for t in np.arange(step, stop + step / 2, step):
+        s = t - step
+        if amplitude == 0.0:
+            slave.setReal([vr["plate_x"], vr["plate_vx"], vr["plate_ax"]],
+                          [a * np.sin(w * s), a * w * np.cos(w * s), -a * w * w * np.sin(w * s)])
+        slave.doStep(s, step)
+        rows.append(slave.getReal(outputs))
+    return np.array(rows)
+
+
+def _fresh(chain_fmu, unzipped, fmu_log):
+    """A new instance from the FMU extracted once into ``unzipped`` (extracting again over
+    the loaded binary would pull it from under the process)."""
+    md = read_model_description(chain_fmu)
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName="chain")
+    slave.instantiate(callbacks=fmu_log.callbacks)
+    return slave, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def test_the_horizontal_inputs_shake_the_chain_like_its_own_drive(chain_fmu, tmp_path, fmu_log):
+    """plate_motion = 1 with drive_angle = pi/2 through fmpy: the inputs plate_x, plate_vx,
+    plate_ax sampled from the drive and held over each communication step give the internal
+    drive's run to ~A omega H / 2, halving with H (the held acceleration lags by half a
+    step); and the FMU driven by the inputs is the core driven by them, to the bit."""
+    errors, unzipped = [], extract(chain_fmu, unzipdir=str(tmp_path / "x"))
+    for step in (0.1, 0.05):
+        runs = []
+        for amplitude in (HORIZONTAL_DRIVE["A"], 0.0):
+            slave, vr = _fresh(chain_fmu, unzipped, fmu_log)
+            runs.append(_shaken_run(slave, vr, amplitude, step))
+            slave.terminate()
+            slave.freeInstance()
+        internal, driven = runs
+        assert np.max(np.abs(internal[:, 1])) > 0.9 * HORIZONTAL_DRIVE["A"]  # the blocks travel with the plate
+        errors.append(np.max(np.abs(driven - internal)))
+        assert errors[-1] < HORIZONTAL_DRIVE["A"] * HORIZONTAL_DRIVE["omega"] * step / 2
+    assert 1.6 < errors[0] / errors[1] < 2.4
+    a, w, step = HORIZONTAL_DRIVE["A"], HORIZONTAL_DRIVE["omega"], 0.05
+    chain = Chain(16, integrator="rk4", plate_motion="oblique", **{**HORIZONTAL_DRIVE, "A": 0.0})
+    chain.start()
+    for t in np.arange(step, 60.0 + step / 2, step):
+        s = t - step
+        chain.set_plate_input(0.0, 0.0, 0.0, a * np.sin(w * s), a * w * np.cos(w * s), -a * w * w * np.sin(w * s))
+        chain.advance_to(chain.time + step)  # (the FMU's doStep ends at its time + the step)
+    assert [chain.x[0], chain.x[15], chain.vx[15]] == driven[-1].tolist()
+
+
+def test_plate_motion_is_named_in_the_model_description_as_the_block_fmus_name_it(chain_fmu):
+    """Masters that set an Integer switch by name (``harness.cosim``, libcosim) read the
+    names from the description: the chain's are the single block's."""
+    from harness.cosim.fmu import FmuInterface
+
+    described = {v.name: v.description for v in read_model_description(chain_fmu).modelVariables}
+    assert FmuInterface.parse_choices(described["plate_motion"]) == {"vertical": 0, "oblique": 1}
+    assert "drive_angle" in described and {"plate_x", "plate_vx", "plate_ax", "plate_z"} <= set(described)
+
+
+def test_bad_plate_motion_settings_give_fmi2error_and_the_instance_goes_on(instance, fmu_log):
+    slave, vr = instance
+    assert status_of(lambda: slave.setReal([vr["drive_angle"]], [float("nan")])) == fmi2Error
+    assert any("drive_angle = nan" in record[3] for record in fmu_log.records)
+    assert status_of(lambda: slave.setInteger([vr["plate_motion"]], [7])) == fmi2Error
+    assert any("plate_motion = 7" in record[3] for record in fmu_log.records)
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()  # the vertical plate of before
+    slave.setReal([vr["plate_x"]], [0.1])
+    assert do_step(slave, 0.0, 100.0) == fmi2Error
+    assert any("plate_motion = 1" in record[3] for record in fmu_log.records)
+    assert status_of(lambda: slave.setInteger([vr["plate_motion"]], [1])) == fmi2Error  # fixed once running
+    slave.setReal([vr["plate_x"]], [0.0])
+    assert do_step(slave, 0.0, 100.0) == 0  # the instance goes on

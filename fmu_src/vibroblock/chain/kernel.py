@@ -17,6 +17,14 @@ quadratures) ends every block's step.  Two schemes:
 Either way a chain of one block is the single block, bit for bit, and the physics of
 contact, friction and plate is written nowhere here.
 
+Under the oblique plate law (``laws.plate_oblique``) each block is integrated in the
+plate's frame, as the single block is: its x and vx are relative to the plate (the
+slip), the friction and contact see them, and the plate's horizontal motion enters as
+each block's frame force -m p_x'' - k_p p_x (``integrators.plate.frame_force``: the
+loader and the leaf springs stay in the lab).  The coupling springs see differences of
+positions, the same in either frame.  So the event catalogue follows the slip velocity
+relative to the plate; ``lab_offset`` gives what the lab's x and vx add.
+
 x is each block's displacement from its place in the unloaded chain; the loader of
 block i sits at V_d t, so the drive spring of the single block is the chain's leaf
 spring k_p, and a coupling spring's stretch is the difference of two displacements.
@@ -28,9 +36,11 @@ from numba import njit
 
 from ..dynamics import contact, coulomb_bound
 from ..integrators.fixed_step import NON_FINITE, OK, settle
-from ..integrators.plate import drive_sin_cos, next_sin_cos, plate_at, plate_moves
+from ..integrators.plate import (drive_sin_cos, frame_force, next_sin_cos, phase_after, plate_at, plate_moves,
+                                 plate_sideways)
 from ..integrators.rk4 import stage_rates
 from ..integrators.symplectic_euler import euler_step
+from ..laws import plate_moves_sideways
 from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_M, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
                       Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..unowned import data_pointer, row_pointer
@@ -90,17 +100,23 @@ def couple(Y, chn, scratch):
 
 
 @njit(inline="always")
-def step_block(kind, prm, y, clock, plate, push, resets, track_energy):
+def step_block(kind, prm, y, clock, plate, forces, resets, track_energy):
     """One step of one block: the single block's symplectic Euler step with the coupling
-    ``push``, then its driver's friction rule and quadratures (``fixed_step.settle``).
-    ``y``, ``prm``: the block's slots; ``clock`` = (t, t + h, h); ``plate`` = (height,
-    velocity) at t and t + h.  Returns the block's Coulomb resets after the step."""
+    and the plate frame's force ``forces`` = (coupling, frame) at t, then its driver's
+    friction rule and quadratures (``fixed_step.settle``).  ``y``, ``prm``: the block's
+    slots; ``clock`` = (t, t + h, h); ``plate`` = (height, velocity) at t and t + h.
+    Returns the block's Coulomb resets after the step."""
     t, t1, h = clock
     pz0, pv0, pz1, pv1 = plate
+    coupling, frame = forces
+    # (the single block's push is the frame's force alone: a lone block's coupling 0.0 adds nothing to it)
+    push = coupling + frame if frame != 0.0 else coupling
     x, z, vx, vz, shear = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F]
     contact0 = contact(kind, x, z, vx, vz, pz0, pv0, prm)
     x, z, vx, vz, shear, contact1, d_phi, d_work, d_dissipated, d_normal = euler_step(
         kind, prm, (x, z, vx, vz, shear), t, h, contact0, (pv0, pz1, pv1), track_energy, push)
+    if track_energy and frame != 0.0:  # the frame's force works on the block, as in symplectic_euler.step
+        d_work += h * frame * y[Y_VX]
     return finish_block(kind, prm, y, (x, z, vx, vz, shear), contact1, (t1, h),
                         (d_phi, d_work, d_dissipated, d_normal), resets, track_energy)
 
@@ -129,12 +145,15 @@ STAGE_WEIGHTS = (1.0, 2.0, 2.0, 1.0)
 
 
 @njit(inline="always")
-def rk4_stage(kind, Y, PRM, chn, scratch, stage, clock, plate, track_energy):
+def rk4_stage(kind, drv, Y, PRM, chn, scratch, stage, clock, plate, track_energy):
     """Stage ``stage`` of rk4 for every block: its state at the stage from the previous
     stage's rates, the coupling from the neighbours' positions there, its rates
-    (``rk4.stage_rates`` plus the coupling), added to the weighted sum.  ``clock`` = (t, span);
-    ``plate`` = (height, velocity) at the stage."""
+    (``rk4.stage_rates`` with the plate frame's force, plus the coupling), added to the
+    weighted sum.  ``clock`` = (t, span); ``plate`` = (height, velocity) at the stage, and
+    the drive's sine, cosine and the time at which the single block's driver takes the
+    frame's force for the stage."""
     t, span = clock
+    sideways = plate_moves_sideways(kind)
     offset = STAGE_OFFSETS[stage] * span
     for i in range(Y.shape[0]):  # every stage position first: the coupling needs the neighbours'
         scratch[i, S_STAGE_X] = Y[i, Y_X] + offset * scratch[i, S_RATES] if stage > 0 else Y[i, Y_X]
@@ -146,8 +165,9 @@ def rk4_stage(kind, Y, PRM, chn, scratch, stage, clock, plate, track_energy):
         if stage > 0:  # (the first stage at the state itself, to the bit)
             state = (scratch[i, S_STAGE_X], state[1] + offset * rates[1], state[2] + offset * rates[2],
                      state[3] + offset * rates[3], state[4] + offset * rates[4])
+        frame = frame_force(kind, drv, prm, plate[2], plate[3], plate[4]) if sideways else 0.0
         new = stage_rates(kind, prm, state[0], state[1], state[2], state[3], state[4], t + offset, plate[0],
-                          plate[1], 0.0, track_energy)
+                          plate[1], frame, track_energy)
         push = chn[H_KC] * pull_on(scratch[:, S_STAGE_X], i, periodic)
         weight = STAGE_WEIGHTS[stage]
         for k in range(N_RATES):
@@ -159,19 +179,20 @@ def rk4_stage(kind, Y, PRM, chn, scratch, stage, clock, plate, track_energy):
 
 
 @njit(inline="always")
-def rk4_step(kind, Y, PRM, chn, scratch, clock, plates, track_energy):
+def rk4_step(kind, drv, Y, PRM, chn, scratch, clock, plates, track_energy):
     """One rk4 step of the whole chain, each block then finished as the single block's
-    (``finish_block``).  ``clock`` = (t, t + h, h, span); ``plates`` = (height, velocity)
-    at t, t + h/2 and t + h.  The block's own rk4 arithmetic, to the bit, where no
-    coupling acts."""
+    (``finish_block``).  ``clock`` = (t, t + h, h, span); ``plates`` = the stage plates
+    of ``rk4_stage`` at t, t + h/2 and t + h.  The block's own rk4 arithmetic, to the
+    bit, where no coupling acts."""
     t, t1, h, span = clock
-    pz0, pv0, pzh, pvh, pz1, pv1 = plates
+    start, half, end = plates
+    pz1, pv1 = end[0], end[1]
     for i in range(Y.shape[0]):
         scratch[i, S_X_BEFORE] = Y[i, Y_X]
-    rk4_stage(kind, Y, PRM, chn, scratch, 0, (t, span), (pz0, pv0), track_energy)
-    rk4_stage(kind, Y, PRM, chn, scratch, 1, (t, span), (pzh, pvh), track_energy)
-    rk4_stage(kind, Y, PRM, chn, scratch, 2, (t, span), (pzh, pvh), track_energy)
-    rk4_stage(kind, Y, PRM, chn, scratch, 3, (t, span), (pz1, pv1), track_energy)
+    rk4_stage(kind, drv, Y, PRM, chn, scratch, 0, (t, span), start, track_energy)
+    rk4_stage(kind, drv, Y, PRM, chn, scratch, 1, (t, span), half, track_energy)
+    rk4_stage(kind, drv, Y, PRM, chn, scratch, 2, (t, span), half, track_energy)
+    rk4_stage(kind, drv, Y, PRM, chn, scratch, 3, (t, span), end, track_energy)
     sixth = span / 6.0
     for i in range(Y.shape[0]):
         prm, y = row_pointer(PRM, i), row_pointer(Y, i)
@@ -252,6 +273,7 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
     rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
     half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
     rk4 = chn[H_SCHEME] == RK4
+    sideways = plate_moves_sideways(kind)
     s, c = drive_sin_cos(drv, cnt, n)
     t = t0 + n * dt
     pz0, pv0 = plate_at(drv, s, c, t)
@@ -259,21 +281,25 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
     for _ in range(n_steps):
         n1 = n + 1
         t1 = t0 + n1 * dt
+        s0, c0 = s_half, c_half = s, c
         pz1, pv1 = pzh, pvh = pz0, pv0
         if moving:
+            s_half, c_half = s * half_c + c * half_s, c * half_c - s * half_s
             if rk4:  # the half step's plate, as the single block's driver takes it
-                pzh, pvh = plate_at(drv, s * half_c + c * half_s, c * half_c - s * half_s, t + 0.5 * dt)
+                pzh, pvh = plate_at(drv, s_half, c_half, t + 0.5 * dt)
             s, c = next_sin_cos(drv, cnt, n1, s, c, rot_s, rot_c)
             pz1, pv1 = plate_at(drv, s, c, t1)
         if rk4:
-            rk4_step(kind, Y, PRM, chn, scratch, (t, t1, dt, t1 - t), (pz0, pv0, pzh, pvh, pz1, pv1),
+            rk4_step(kind, drv, Y, PRM, chn, scratch, (t, t1, dt, t1 - t),
+                     ((pz0, pv0, s0, c0, t), (pzh, pvh, s_half, c_half, t + 0.5 * dt), (pz1, pv1, s, c, t1)),
                      track_energy)
         else:
             couple(Y, chn, scratch)
             for i in range(Y.shape[0]):
-                scratch[i, S_RESETS] = step_block(kind, row_pointer(PRM, i), row_pointer(Y, i), (t, t1, dt),
-                                                  (pz0, pv0, pz1, pv1), scratch[i, S_PUSH], scratch[i, S_RESETS],
-                                                  track_energy)
+                prm = row_pointer(PRM, i)
+                frame = frame_force(kind, drv, prm, s0, c0, t) if sideways else 0.0
+                scratch[i, S_RESETS] = step_block(kind, prm, row_pointer(Y, i), (t, t1, dt), (pz0, pv0, pz1, pv1),
+                                                  (scratch[i, S_PUSH], frame), scratch[i, S_RESETS], track_energy)
         if chn[H_CLUSTERS] != 0.0:
             status = cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1)
         else:
@@ -286,3 +312,17 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
         if not math.isfinite(Y[i, Y_X] + Y[i, Y_Z] + Y[i, Y_VX] + Y[i, Y_VZ] + Y[i, Y_F]):
             return NON_FINITE
     return status
+
+
+@njit(cache=True)
+def lab_offset(kind, drv, cnt):
+    """The plate's horizontal position and velocity at the stored grid step, which the
+    lab's x and vx add to the blocks' (plate-frame) slots: the single block's observation
+    at a grid time (``fixed_step.observe``, exact sin/cos), 0 under the vertical law."""
+    drv, cnt = data_pointer(drv), data_pointer(cnt)
+    if not plate_moves_sideways(kind):
+        return 0.0, 0.0
+    n = cnt[C_STEP]
+    phase = phase_after(drv, cnt, n, 0.0)
+    position, velocity, _ = plate_sideways(kind, drv, math.sin(phase), math.cos(phase), drv[D_T0] + n * drv[D_DT])
+    return position, velocity

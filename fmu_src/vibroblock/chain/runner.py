@@ -7,6 +7,12 @@ coupling springs k_c between neighbours, a leaf spring k_p (the single block's d
 spring k_d) per block, per-block mu_s and weights drawn from a seeded distribution, and
 the event catalogue.  Outputs are at the grid point at or
 before the requested time (a communication step that is a multiple of dt hits the grid).
+
+The plate is shaken by the single block's plate law (``plate_motion``: vertical, or
+oblique along ``drive_angle`` with the inputs plate_x, plate_vx, plate_ax); under the
+oblique law the blocks' state is kept in the plate's frame (``chain.kernel``), ``x`` and
+``vx`` are the lab's, and the slip velocities (events, aggregates) are relative to the
+plate.
 """
 from __future__ import annotations
 
@@ -29,6 +35,7 @@ GRID_TOLERANCE = 1e-6
 # stiffest spring (rk4's as the single block's check asks).
 SCHEMES = {"symplectic_euler": K.SYMPLECTIC_EULER, "rk4": K.RK4}
 STABLE = {"symplectic_euler": 1.0, "rk4": 4.0}
+LAB_SLOTS = {"x": (L.Y_X, 0), "vx": (L.Y_VX, 1)}  # an output's state slot and its part of kernel.lab_offset
 CATALOG_ROWS = 4096  # rows the kernel fills before the runner empties them
 # The chain's own parameters: name -> (default, unit, description).  The blocks'
 # parameters are model A's, with the drive spring k_d called k_p (the leaf spring).
@@ -156,7 +163,7 @@ class Chain:
         self.rows = self._catalogue_rows()
         self.events: list[tuple] = []
         self.time = float(t0)
-        plate_z = self.settings.parameters["A"] * math.sin(self.drv[L.D_PHASE])
+        plate_z = self.drv[L.D_AMP] * math.sin(self.drv[L.D_PHASE])  # (the drive's vertical part: A if vertical)
         for i in range(self.n_blocks):
             self.Y[i, L.Y_E_NORMAL] = contact_energy(self.settings, self.PRM[i], plate_z - self.Y[i, L.Y_Z])
         self.energy_at_start = self.stored_energy(plate_z)
@@ -197,10 +204,12 @@ class Chain:
         rows = max(CATALOG_ROWS, 2 * (self.n_blocks + 1)) if self.clusters else CATALOG_ROWS
         return np.zeros((rows, K.N_ROW))
 
-    def set_plate_input(self, z: float, v: float, a: float) -> None:
-        run_arrays.check_plate_input((z, v, a))
+    def set_plate_input(self, z: float, v: float, a: float, *along_x: float) -> None:
+        """External plate motion from the current time on, as ``Block.set_plate_input``:
+        ``along_x`` = (x, vx, ax) under plate_motion = 1 (oblique) only."""
+        run_arrays.check_plate_input((z, v, a, *along_x), self.settings.readings)
         self._require_started()
-        run_arrays.set_plate_input(self.drv, self.time, z, v, a)
+        run_arrays.set_plate_input(self.drv, self.time, z, v, a, *along_x)
 
     def advance_to(self, t_end: float) -> None:
         """Advance to the grid point at or before t_end; on failure the state is kept."""
@@ -238,8 +247,24 @@ class Chain:
             raise ModelError("the run has not started: call start() (FMI: exit initialization mode) first")
 
     # ------------------------------------------------------------------ observing
-    x = property(lambda self: self.Y[:, L.Y_X].copy(), doc="Each block's displacement.")
-    vx = property(lambda self: self.Y[:, L.Y_VX].copy(), doc="Each block's slip velocity.")
+    x = property(lambda self: self._lab(L.Y_X, 0), doc="Each block's displacement in the lab.")
+    vx = property(lambda self: self._lab(L.Y_VX, 1), doc="Each block's velocity in the lab.")
+    slip_velocity = property(lambda self: self.Y[:, L.Y_VX].copy(),
+                             doc="Each block's velocity relative to the plate (vx under vertical shaking).")
+
+    def _lab(self, slot: int, which: int, block: int | None = None):
+        """The blocks' slot ``slot`` in the lab (of one ``block``, else of all): the plate
+        frame's plus the plate's position (which = 0) or velocity (1) under the oblique
+        plate law (``kernel.lab_offset``)."""
+        values = self.Y[:, slot].copy() if block is None else float(self.Y[block, slot])
+        if run_arrays.plate_law(self.settings.readings).SIDEWAYS:
+            values += K.lab_offset(self.settings.kind, self.drv, self.cnt)[which]
+        return values
+
+    def lab(self, name: str, block: int) -> float:
+        """One block's ``x`` or ``vx`` in the lab, as ``Chain.x[block]`` (an FMU's scalar
+        output reads one block without copying all)."""
+        return self._lab(*LAB_SLOTS[name], block)
     mu_s = property(lambda self: self.PRM[:, L.P_MUS].copy(), doc="Each block's static friction coefficient.")
     gravity = property(lambda self: self.PRM[:, L.P_G].copy(), doc="Each block's g: its weight is m g.")
     grid_time = property(lambda self: float(self.drv[L.D_T0] + self.cnt[L.C_STEP] * self.drv[L.D_DT]))

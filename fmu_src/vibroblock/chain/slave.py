@@ -12,9 +12,8 @@ from __future__ import annotations
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.variables import Boolean, Integer, Real, String
 
-from .. import layout as L
 from ..fmi import FmuFacade, PlateInputs, fmu_class
-from ..interface import VERTICAL_INPUTS as INPUTS, reading_choices
+from ..interface import INPUTS, reading_choices
 from ..models import parameters_for
 from ..settings import ModelError
 from .runner import CHAIN_PARAMETERS, SCHEMES, Chain
@@ -22,7 +21,9 @@ from .runner import CHAIN_PARAMETERS, SCHEMES, Chain
 # The blocks' parameters the chain offers (model A's physics; the drive spring is the leaf
 # spring k_p; the single block's start and tolerance parameters do not apply).
 BLOCK_PARAMETERS = ("m", "g", "k_n", "k_t", "gamma_n", "gamma_t", "mu_s", "k_d", "V_d", "A", "omega", "dt", "mu_k",
-                    "v_w")
+                    "v_w", "drive_angle")
+# The single block's laws the chain offers, Integer parameters fixed before the start.
+LAWS = ("friction_law", "plate_motion")
 AGGREGATES = {
     "mean_slip_velocity": ("Real", "delta_0/tau_0", "mean of the blocks' slip velocities vx"),
     "moment_rate": ("Real", "delta_0/tau_0", "potency rate: the sum of the blocks' slip velocities"),
@@ -36,9 +37,9 @@ AGGREGATES = {
     "energy_residual": ("Real", "m_0 delta_0^2/tau_0^2",
                         "stored energy - stored at start - work + dissipated (energy_balance)"),
 }
-PER_BLOCK_SLOTS = {"x": L.Y_X, "vx": L.Y_VX}  # each output's slot of a block's state
-PER_BLOCK = {"x": "displacement of block {i} from its place in the unloaded chain [delta_0]",
-             "vx": "slip velocity of block {i} [delta_0/tau_0]"}
+PER_BLOCK = {"x": "displacement of block {i} from its place in the unloaded chain, in the lab [delta_0]",
+             "vx": "velocity of block {i} in the lab (its slip velocity less the plate's plate_vx and drive under "
+                   "plate_motion = 1) [delta_0/tau_0]"}
 CATALOG_TEXT = ("path of the event catalogue (CSV, one row per event, written as events close; the thresholds "
                 "v_start and v_stop are stated in its first line); empty: no file (event_count still counts)")
 
@@ -70,11 +71,12 @@ class ChainFacade(PlateInputs, FmuFacade):
             self._parameter(Real, fmu_name, f"{text} [{spec.unit}]")
         for name, (_, unit, text) in CHAIN_PARAMETERS.items():
             self._parameter(Real, name, f"{text} [{unit}]")
-        self.register_variable(Integer(
-            "friction_law", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-            description=f"each block's friction law: {reading_choices('friction_law')}",
-            getter=lambda: self.chain.settings.readings["friction_law"],
-            setter=lambda value: self._guard(self._set_friction_law, int(value))))
+        for name in LAWS:
+            self.register_variable(Integer(
+                name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+                description=f"each block's {name.replace('_', ' ')}: {reading_choices(name)}",
+                getter=lambda name=name: self.chain.settings.readings[name],
+                setter=lambda value, name=name: self._guard(self._set_law, name, int(value))))
         self.register_variable(Integer(
             "integrator", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description="the chain's scheme: 0 = symplectic_euler (the paper's, first order), 1 = rk4 (fourth order "
@@ -136,9 +138,9 @@ class ChainFacade(PlateInputs, FmuFacade):
         self.periodic = periodic
         self.chain.periodic = periodic
 
-    def _set_friction_law(self, value: int) -> None:
-        self._require_not_started("friction_law")
-        self.chain.settings.set_reading("friction_law", value)
+    def _set_law(self, name: str, value: int) -> None:
+        self._require_not_started(name)
+        self.chain.settings.set_reading(name, value)
 
     def _set_integrator(self, value: int) -> None:
         self._require_not_started("integrator")
@@ -174,7 +176,7 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _block_output(self, name: str, i: int) -> float:
         if not self.chain.started:
             return 0.0
-        return float(self.chain.Y[i, PER_BLOCK_SLOTS[name]])
+        return self.chain.lab(name, i)
 
     # ------------------------------------------------------------------ facade hooks
     def _is_started(self) -> bool:
@@ -203,7 +205,7 @@ class ChainFacade(PlateInputs, FmuFacade):
                 "plate_input": dict(self.plate_input), "input_changed": self._input_changed,
                 "parameters": {name: self.chain.parameter(name) for name in self._parameter_names()},
                 "periodic": self.periodic, "energy_balance": self.chain.energy_balance,
-                "friction_law": self.chain.settings.readings["friction_law"], "clusters": self.chain.clusters,
+                **{name: self.chain.settings.readings[name] for name in LAWS}, "clusters": self.chain.clusters,
                 "integrator": self.chain.settings.integrator,
                 "catalog_file": self.catalog_file}
 
@@ -212,7 +214,7 @@ class ChainFacade(PlateInputs, FmuFacade):
 
     def _restore(self, state: dict) -> None:
         chain = Chain(self.n_blocks, periodic=bool(state["periodic"]), energy_balance=bool(state["energy_balance"]),
-                      friction_law=int(state["friction_law"]), clusters=bool(state["clusters"]),
+                      **{name: int(state.get(name, 0)) for name in LAWS}, clusters=bool(state["clusters"]),
                       integrator=str(state["integrator"]),
                       **{name: float(value) for name, value in state["parameters"].items()})
         if state["chain"] is not None:

@@ -18,7 +18,7 @@ from pythonfmu3.variables import Dimension, Float64, UInt64
 from ..fmi import fmu_class
 from ..fmi3 import Fmi3Adapter
 from ..settings import ModelError
-from .slave import PER_BLOCK, PER_BLOCK_SLOTS, ChainFacade
+from .slave import PER_BLOCK, ChainFacade
 
 # The cluster catalogue keeps (N + 1)(N + 6) doubles: 800 MB at this N.
 MAX_BLOCKS = 10000
@@ -54,7 +54,7 @@ class ChainArrayFacade(ChainFacade):
     def _block_outputs(self, name: str) -> list:
         if not self.chain.started:
             return [0.0] * self.n_blocks
-        return self.chain.Y[:, PER_BLOCK_SLOTS[name]].tolist()
+        return getattr(self.chain, name).tolist()  # (the lab's: Chain.x, Chain.vx)
 
     def _set_n_blocks(self, value) -> None:
         self._require_not_started("N")
