@@ -7,8 +7,10 @@ given), persisting every sweep point and task under ``<out>/store`` so an interr
 job resumes where it stopped; draws the figures; writes the measured values
 (``<out>/claims.json``) and the report (``<out>/report.md``).  The claims the readings of
 the paper's equations can change (C2, C5-C8) are measured under each reading
-(:mod:`harness.paper.claims.readings`) unless ``--default-reading-only``.  ``--quick`` is
-a few-minute version at a coarser resolution.
+(:mod:`harness.paper.claims.readings`) unless ``--default-reading-only``, and under the
+law readings beside them (the load-only bound, the non-conservative and the no-pull
+contacts; C6 there measures Fig. 5's diagram) unless ``--no-laws``.  ``--quick`` is a
+few-minute version at a coarser resolution.
 """
 from __future__ import annotations
 
@@ -35,10 +37,10 @@ def main(argv: list[str] | None = None) -> Path:
     parser.add_argument("--default-reading-only", action="store_true",
                         help="measure C2 and C5-C8 under the default reading only, not under each reading of the "
                              "paper's equations (formulation x Coulomb bound)")
-    parser.add_argument("--laws", action="store_true",
-                        help="measure C2 and C5-C8 under the load-only Coulomb bound and the linear_along_normal and "
-                             "linear_no_pull contacts too (harness.paper.claims.readings.LAW_READINGS); beyond the "
-                             "default job's time budget")
+    parser.add_argument("--no-laws", action="store_true",
+                        help="skip the law readings: C2 and C5-C8 under the load-only Coulomb bound and the "
+                             "linear_along_normal and linear_no_pull contacts (C6: Fig. 5's diagram) "
+                             "(harness.paper.claims.readings.LAW_READINGS)")
     parser.add_argument("--ensembles-every-reading", action="store_true",
                         help="run C6's start-phase ensemble under every reading, not only the default one (beyond "
                              "the default job's time budget)")
@@ -65,7 +67,7 @@ def main(argv: list[str] | None = None) -> Path:
         runner = Runner(out / "store", resolution, execution, client, fmus)
         runner.ensembles_every_reading = args.ensembles_every_reading
         studies = run_studies(runner, progress=not args.no_progress, readings=not args.default_reading_only,
-                              laws=args.laws)
+                              laws=not args.no_laws)
     except StudiesFailed as exc:
         raise SystemExit(f"python -m harness.main: {exc}") from exc
     finally:

@@ -105,7 +105,7 @@ FIGURE_5 = {"C6b": "Fig. 5, first transition at A = P_l/(m omega^2)",
 def reproduction_markdown(studies: dict[str, Study]) -> list[str]:
     """Per claim part: under which readings and laws it agrees with the paper, and under
     which it does not (with the verdict); the laws appear where they were measured
-    (``python -m harness.main --laws``)."""
+    (``python -m harness.main`` unless ``--no-laws``)."""
     table = reading_rows(studies, laws=True, single=True)
     if not table:
         return []
@@ -116,10 +116,10 @@ def reproduction_markdown(studies: dict[str, Study]) -> list[str]:
              "**agrees**, and the others with their verdicts. A part measured under the default reading only lists "
              "that one. "
              + ("The load-only bound and the linear_along_normal and linear_no_pull contacts were measured too "
-                "(`--laws`)." if laws_measured else
+                "(C6 under them: Fig. 5's diagram, C6a-C6c)." if laws_measured else
                 "The load-only bound and the linear_along_normal and linear_no_pull contacts were not measured in "
-                "this run (`python -m harness.main --laws` measures them; they do not fit the default job's time "
-                "budget)."), "",
+                "this run (`python -m harness.main` measures them unless given `--no-laws` or "
+                "`--default-reading-only`)."), "",
              "| part | reproduces the paper under | does not, under |", "|---|---|---|"]
     for part, per_part in table.items():
         order = [r for r in measured if r in per_part]

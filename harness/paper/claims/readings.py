@@ -8,7 +8,8 @@ can change (C2, C5-C8) are measured under all four combinations; the report show
 verdicts side by side and says where a verdict flips with the reading.
 
 Beside the readings, two laws of the FMUs change what a claim may measure
-(``LAW_READINGS``, measured on request: ``python -m harness.main --laws``): the Coulomb
+(``LAW_READINGS``, measured by the main job unless ``--no-laws``; C6 under them measures
+Fig. 5's diagram, not its k_n sweep and ramp): the Coulomb
 bound ``load_only`` (N = the applied load's normal component alone, the paper's "mu_s m g"
 without the drive spring's share) and the contact laws ``linear_along_normal`` (the
 force k_n delta n of earlier releases, not conservative on a curved plate) and
@@ -80,7 +81,7 @@ ALL_READINGS = READINGS + LAW_READINGS
 
 
 def law_readings(claim_readings: tuple) -> tuple:
-    """The law readings measured on request for a claim measured under ``claim_readings``:
+    """The law readings measured beside the paper's readings for a claim measured under ``claim_readings``:
     none for a claim the readings cannot change (default reading only)."""
     if len(claim_readings) < 2:
         return ()

@@ -26,7 +26,7 @@ def test_model_a_runs_exactly_where_the_event_driven_scheme_applies(runner):
 
 @pytest.mark.parametrize("contact_law, exact", [(1, True), (2, False)])
 def test_model_a_keeps_the_exact_flows_only_under_a_linear_contact_law(runner, fmu_dir, contact_law, exact):
-    """The law readings (--laws): the contact along the normal is linear (exact flows); the
+    """The law readings (measured by the main job): the contact along the normal is linear (exact flows); the
     no-pull contact is clipped, which event_driven refuses, so its runs take Euler, and
     the FMU accepts the run the runner chose."""
     from harness.runs.run import simulate
