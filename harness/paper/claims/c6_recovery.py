@@ -82,7 +82,7 @@ def study_c6(runner: Runner) -> Study:
     # and C6e's ramp, each as costly as the diagram, stay with the paper's readings.
     fig5_only = runner.reading not in READINGS
     [frictionless] = runner.tasks(run_and_measure, [k_t_zero])
-    [loop] = [] if fig5_only else runner.tasks(ramp_task, [ramp_item])
+    loop = None if fig5_only else runner.tasks(ramp_task, [ramp_item])[0]
 
     base = PointSettings(run=c_run(runner, res.c_horizon), observe=observe_c)
     diagram = runner.sweep(Grid((Axis("A", res.c6_amplitudes), Axis("omega", res.c6_omegas))), base)

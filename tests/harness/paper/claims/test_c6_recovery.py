@@ -1,6 +1,7 @@
 """C6: both transitions of a diagram row bisected in omega, and the verdicts on located values."""
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import pytest
@@ -233,3 +234,45 @@ def test_under_a_law_reading_c6_judges_fig_5_s_parts_only():
     assert {r.claim for r in verdict_c6(paper)} == {"C6a", "C6b", "C6c", "C6d", "C6e"}
     assert {r.claim for r in verdict_c6(law)} == {"C6a", "C6b", "C6c"}
     assert ([r.verdict for r in verdict_c6(law)] == [r.verdict for r in verdict_c6(paper)][:3])
+
+
+class Diagram(Regimes):
+    """``Regimes`` with the sweep of a grid: a runner for the whole study, recording what it was asked."""
+
+    reading = None
+    resolution = None
+    asked: list
+
+    def sweep(self, grid, base):
+        import numpy as np
+        import xarray as xr
+
+        self.asked.append(("sweep", tuple(a.name for a in grid.axes)))
+        names = [a.name for a in grid.axes]
+        values = [np.asarray(a.values, dtype=float) for a in grid.axes]
+        mesh = np.meshgrid(*values, indexing="ij")
+        regimes = np.vectorize(lambda a, w: self.regime(a, w), otypes=[object])(mesh[0], mesh[1])
+        return xr.Dataset({"regime": (names, regimes)}, coords=dict(zip(names, values)))
+
+    def tasks(self, function, items):
+        self.asked.append(("tasks", function.__name__, len(items)))
+        return [{"observables": {"regime": self.regime(float(i["point"].run.parameters["A"]),
+                                                       float(i["point"].run.parameters["omega"])),
+                                 "slip_events": 0, "phi": 0.0, "drift_velocity": 0.01}} for i in items]
+
+
+def test_a_law_reading_s_c6_runs_the_diagram_and_not_the_k_n_sweep_or_the_ramp(monkeypatch):
+    """Run end to end on a stand-in runner: under a law reading the study asks for one sweep
+    (the A-omega diagram) and no ramp, and its verdicts are C6a-C6c."""
+    from harness.paper.claims.readings import LAW_READINGS
+    from harness.paper.claims.study import RESOLUTIONS
+
+    runner = Diagram(lambda a: 1 / math.sqrt(max(a, 1e-9)), lambda a: 14.0 + a)
+    runner.asked, runner.reading = [], LAW_READINGS[0]
+    runner.resolution = dataclasses.replace(RESOLUTIONS["tiny"], ensemble_wavelengths=0.0)
+    monkeypatch.setattr(c6_recovery, "c_run", lambda r, horizon, **p: RunSettings(parameters={"A": 0.0, "omega": 1.0,
+                                                                                              **p}))
+    study = c6_recovery.study_c6(runner)
+    assert [a for a in runner.asked if a[0] == "sweep"] == [("sweep", ("A", "omega"))]
+    assert not [a for a in runner.asked if a[0] == "tasks" and a[1] == "ramp_task"]
+    assert {r.claim for r in verdict_c6(study.measured)} == {"C6a", "C6b", "C6c"}
