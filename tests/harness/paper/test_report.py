@@ -8,6 +8,7 @@ import pytest
 
 from harness.paper import report
 from harness.paper.claims import CLAIMS, load_studies, study_name
+from harness.paper.claims.readings import law_readings
 from harness.paper.claims.verdicts import AGREES, DISAGREES, FLIPS, NOT_REPRODUCED, fmt
 
 
@@ -25,7 +26,10 @@ def test_tiny_main_job_writes_a_report_from_its_measurements(tiny_job):
     out, path = tiny_job
     text = path.read_text()
     studies = load_studies(out / "claims.json")
-    assert set(studies) == {study_name(name, r) for name, claim in CLAIMS.items() for r in claim.readings}
+    # The main job measures every claim under its readings and, by default, its law readings.
+    assert set(studies) == {study_name(name, r) for name, claim in CLAIMS.items()
+                            for r in claim.readings + law_readings(claim.readings)}
+    assert "The load-only bound and the linear_along_normal and linear_no_pull contacts were measured too" in text
     assert {"Fig1b", "C6r"} | {f"C{n}" for n in range(1, 9)} <= set(studies)
     rows = report.claim_rows(studies)
     for row in rows:
