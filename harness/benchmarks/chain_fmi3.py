@@ -30,15 +30,21 @@ from . import ROOT, recorded
 SETTINGS = {"mu_s_spread": 0.3, "seed": 1}
 
 
-def _fmi2_run(fmu: Path, folder: str, n_blocks: int, step: float, points: int):
+def _instantiated(slave_class, fmu: Path, folder: str, name: str):
+    """(an instantiated fmpy slave of ``fmu`` extracted into ``folder``, its value references by name)."""
     from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
 
     md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=folder),
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="fmi2")
+    slave = slave_class(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=folder),
+                        modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
     slave.instantiate()
+    return slave, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def _fmi2_run(fmu: Path, folder: str, n_blocks: int, step: float, points: int):
+    from fmpy.fmi2 import FMU2Slave
+
+    slave, vr = _instantiated(FMU2Slave, fmu, folder, "fmi2")
     slave.setReal([vr[name] for name in SETTINGS], list(SETTINGS.values()))
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
@@ -51,14 +57,9 @@ def _fmi2_run(fmu: Path, folder: str, n_blocks: int, step: float, points: int):
 
 
 def _fmi3_run(fmu: Path, folder: str, n_blocks: int, step: float, points: int):
-    from fmpy import extract, read_model_description
     from fmpy.fmi3 import FMU3Slave
 
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    slave = FMU3Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=folder),
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="fmi3")
-    slave.instantiate()
+    slave, vr = _instantiated(FMU3Slave, fmu, folder, "fmi3")
     slave.enterConfigurationMode()
     slave.setUInt64([vr["N"]], [n_blocks])
     slave.exitConfigurationMode()

@@ -8,15 +8,13 @@ import pytest
 from vibroblock import Block
 from vibroblock import layout as L
 from vibroblock.chain import Chain
+
+from chain_testing import chain_of, run_side_by_side
 from vibroblock.chain import runner
 from vibroblock.settings import ModelError
 
 # Stick-slip of the single block's benchmarks, on a vibrating plate (resets, detachments).
 VIBRATED = dict(A=0.3, omega=0.8, k_d=1e-2, V_d=1e-2, gamma_t=5e-3, dt=1e-2)
-
-
-def _chain(n, **parameters):
-    return Chain(n, **{("k_p" if k == "k_d" else k): v for k, v in parameters.items()})
 
 
 RATE_STATE = {"friction_law": 3, "rs_D_c": 0.1, "rs_V_0": 1e-3, "rs_theta_0": 100.0}
@@ -29,12 +27,8 @@ def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law, integrator):
     (under the paper's friction, and under the kinetic and the rate-and-state laws, whose
     state rides along), with either scheme."""
     block = Block("A", integrator, 0, True, **VIBRATED, **law)
-    chain = _chain(1, energy_balance=True, integrator=integrator, **VIBRATED, **law)
-    block.start()
-    chain.start()
-    for t in np.arange(1, 61) * 50.0:
-        block.advance_to(t)
-        chain.advance_to(t)
+    chain = chain_of(1, energy_balance=True, integrator=integrator, **VIBRATED, **law)
+    run_side_by_side(block, chain)
     if law is RATE_STATE:  # the run exercised the friction rule: theta moved (it has no resets)
         assert abs(block.y[L.Y_FRICTION_STATE] - RATE_STATE["rs_theta_0"]) > 1.0
     else:
@@ -46,7 +40,7 @@ def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law, integrator):
 
 
 def test_uncoupled_blocks_are_independent_single_blocks_with_their_own_mu_s():
-    chain = _chain(3, k_c=0.0, mu_s_spread=0.4, seed=7, **VIBRATED)
+    chain = chain_of(3, k_c=0.0, mu_s_spread=0.4, seed=7, **VIBRATED)
     chain.start()
     chain.advance_to(1500.0)
     assert len(set(chain.mu_s)) == 3
@@ -61,7 +55,7 @@ def test_uncoupled_blocks_with_spread_loads_are_single_blocks_of_those_weights()
     """k_c = 0 and both spreads: each block is Block("A") with its own mu_s and g, bit for
     bit, on a vibrated plate; a block of the model's weight would sit elsewhere on its
     contact (the loads reach the contact)."""
-    chain = _chain(3, k_c=0.0, mu_s_spread=0.3, load_spread=0.5, seed=9, **VIBRATED)
+    chain = chain_of(3, k_c=0.0, mu_s_spread=0.3, load_spread=0.5, seed=9, **VIBRATED)
     chain.start()
     chain.advance_to(1500.0)
     assert len(set(chain.gravity)) == 3 and not np.any(chain.gravity == 1.0)
@@ -107,7 +101,7 @@ def test_small_oscillations_of_stuck_blocks_ring_at_the_normal_mode_frequencies(
     for j in range(n):
         if j > 0 and abs(values[j] - values[j - 1]) < 1e-12:
             continue  # a degenerate pair (periodic): the first of it is enough
-        chain = _chain(n, periodic=periodic, k_d=k_p, k_t=k_t, k_c=k_c, dt=dt, V_d=0.0, gamma_t=0.0,
+        chain = chain_of(n, periodic=periodic, k_d=k_p, k_t=k_t, k_c=k_c, dt=dt, V_d=0.0, gamma_t=0.0,
                        v_start=1.0, v_stop=0.5)
         chain.start()
         chain.set_velocities(1e-4 * vectors[:, j])
@@ -127,7 +121,7 @@ def test_the_energy_balance_closes_at_first_order_in_dt(n, periodic):
     the books would not shrink (two blocks with periodic ends: two springs between them)."""
     residuals = []
     for dt in (1e-2, 5e-3):
-        chain = _chain(n, energy_balance=True, periodic=periodic, k_c=1.0, mu_s_spread=0.2, seed=3,
+        chain = chain_of(n, energy_balance=True, periodic=periodic, k_c=1.0, mu_s_spread=0.2, seed=3,
                        **{**VIBRATED, "dt": dt})
         chain.start()
         chain.advance_to(3000.0)
@@ -141,7 +135,7 @@ def test_the_energy_balance_closes_at_first_order_in_dt(n, periodic):
 def test_an_event_of_one_uncoupled_block_has_that_blocks_slip_as_potency():
     """k_c = 0: an event of one block is that block's slip between the event's start and
     end, which an independent single-block run gives."""
-    chain = _chain(2, k_c=0.0, mu_s_spread=0.3, seed=2, **VIBRATED)
+    chain = chain_of(2, k_c=0.0, mu_s_spread=0.3, seed=2, **VIBRATED)
     chain.start()
     chain.advance_to(4000.0)
     single = [event for event in chain.events if event[3] == 1]
@@ -160,11 +154,11 @@ def test_a_full_catalogue_loses_no_event_and_changes_nothing(monkeypatch):
     """Without vibration the run does not depend on where the kernel stops: a catalogue of
     two rows, emptied whenever full, gives the same events and the same state."""
     parameters = dict(VIBRATED, A=0.0, omega=0.0)
-    big = _chain(8, mu_s_spread=0.3, seed=5, **parameters)
+    big = chain_of(8, mu_s_spread=0.3, seed=5, **parameters)
     big.start()
     big.advance_to(6000.0)
     monkeypatch.setattr(runner, "CATALOG_ROWS", 2)
-    small = _chain(8, mu_s_spread=0.3, seed=5, **parameters)
+    small = chain_of(8, mu_s_spread=0.3, seed=5, **parameters)
     small.start()
     small.advance_to(6000.0)
     assert len(big.events) > 4
@@ -183,7 +177,7 @@ def test_with_rk4_the_energy_balance_closes_to_rounding_between_resets(law, tole
     of order dt (3e-3 here)."""
     residuals = {}
     for integrator in ("symplectic_euler", "rk4"):
-        chain = _chain(8, integrator=integrator, energy_balance=True, mu_s_spread=0.2, seed=1, **law)
+        chain = chain_of(8, integrator=integrator, energy_balance=True, mu_s_spread=0.2, seed=1, **law)
         chain.start()
         chain.advance_to(20000.0)
         outputs = chain.outputs()
@@ -211,7 +205,7 @@ def test_rk4_s_looser_step_bound_is_checked_with_the_coupling():
 def test_a_state_of_another_layout_is_refused_and_the_run_goes_on():
     """A state whose constants or scratch arrays have another length (saved by another
     version of the chain) would be read past its end by the kernel: refused."""
-    chain = _chain(3)
+    chain = chain_of(3)
     chain.start()
     chain.advance_to(10.0)
     state = chain.get_state()

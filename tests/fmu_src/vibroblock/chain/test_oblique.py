@@ -10,7 +10,8 @@ from scipy.integrate import solve_ivp
 
 from vibroblock import Block
 from vibroblock import layout as L
-from vibroblock.chain import Chain
+
+from chain_testing import chain_of, run_side_by_side
 from vibroblock.chain import kernel as K
 from vibroblock.settings import ModelError
 
@@ -20,10 +21,6 @@ HORIZONTAL = math.pi / 2
 K_T, GAMMA_T, MU_S = 0.28, 5e-3, 0.5  # model A's k_t and mu_s (m = g = 1)
 
 
-def _chain(n, **parameters):
-    return Chain(n, **{("k_p" if k == "k_d" else k): v for k, v in parameters.items()})
-
-
 @pytest.mark.parametrize("integrator", ["symplectic_euler", "rk4"])
 @pytest.mark.parametrize("law", [{}, {"friction_law": 2, "mu_k": 0.3, "v_w": 0.5}])
 def test_a_chain_of_one_block_is_the_single_oblique_block_bit_for_bit(law, integrator):
@@ -31,12 +28,8 @@ def test_a_chain_of_one_block_is_the_single_oblique_block_bit_for_bit(law, integ
     (kept in the plate's frame), the lab's x and vx, the resets and the energy residual
     equal Block("A", plate_motion = oblique)'s, through slips."""
     block = Block("A", integrator, 0, True, **OBLIQUE, **law)
-    chain = _chain(1, energy_balance=True, integrator=integrator, **OBLIQUE, **law)
-    block.start()
-    chain.start()
-    for t in np.arange(1, 61) * 50.0:
-        block.advance_to(t)
-        chain.advance_to(t)
+    chain = chain_of(1, energy_balance=True, integrator=integrator, **OBLIQUE, **law)
+    run_side_by_side(block, chain)
     assert block.counters["resets"] > 10
     assert chain.Y[0, :L.Y_E_START].tolist() == block.y[:L.Y_E_START].tolist()
     out = block.outputs()
@@ -63,7 +56,7 @@ def stuck_reference(amplitude, omega, k_p, times):
 def _shaken(integrator, factor, omega=0.1, k_p=1e-3):
     """Four heterogeneous blocks (mu_s and weight spread by 20 %) on a plate shaken
     horizontally at ``factor`` times the weakest block's rigid threshold A omega^2 = mu_s_i g_i."""
-    chain = _chain(4, integrator=integrator, k_c=0.5, k_p=k_p, V_d=0.0, gamma_t=GAMMA_T, omega=omega,
+    chain = chain_of(4, integrator=integrator, k_c=0.5, k_p=k_p, V_d=0.0, gamma_t=GAMMA_T, omega=omega,
                    plate_motion=1, drive_angle=HORIZONTAL, mu_s_spread=0.2, load_spread=0.2, seed=3)
     weakest = float(np.min(chain.heterogeneity()[0] * chain.heterogeneity()[1]))
     chain.set_parameter("A", factor * weakest / omega ** 2)
@@ -101,7 +94,7 @@ def test_blocks_below_the_friction_threshold_ride_the_horizontally_shaken_plate(
 def test_uncoupled_blocks_are_independent_single_oblique_blocks():
     """k_c = 0 on the obliquely shaken plate: each block is Block("A", plate_motion =
     oblique) with its own mu_s and g, bit for bit in its state and its lab x."""
-    chain = _chain(3, k_c=0.0, mu_s_spread=0.3, load_spread=0.3, seed=5, **OBLIQUE)
+    chain = chain_of(3, k_c=0.0, mu_s_spread=0.3, load_spread=0.3, seed=5, **OBLIQUE)
     chain.start()
     chain.advance_to(1500.0)
     resets = 0
@@ -121,7 +114,7 @@ def test_with_rk4_the_energy_balance_of_a_coupled_chain_closes_in_the_plate_s_fr
     coupling springs) less the work (the frame's force included) plus the dissipation is
     1.5e-10 of the dissipated energy (rk4's first-order resets; symplectic Euler's is 4e-2
     here); a frame force left out of the books would leave the work's order."""
-    chain = _chain(6, energy_balance=True, integrator="rk4", mu_s_spread=0.3, seed=2, **OBLIQUE)
+    chain = chain_of(6, energy_balance=True, integrator="rk4", mu_s_spread=0.3, seed=2, **OBLIQUE)
     chain.start()
     chain.advance_to(3000.0)
     out = chain.outputs()
@@ -140,13 +133,13 @@ def test_the_catalogue_follows_the_slip_velocity_relative_to_the_plate():
 
 
 def test_horizontal_inputs_and_bad_directions_are_refused_saying_why():
-    vertical = _chain(2)
+    vertical = chain_of(2)
     vertical.start()
     with pytest.raises(ModelError, match="plate_motion = 1"):
         vertical.set_plate_input(0.0, 0.0, 0.0, 0.1, 0.0, 0.0)
     vertical.set_plate_input(0.1, 0.0, 0.0)  # a vertical input is taken as before
     for angle in (math.nan, math.inf):
         with pytest.raises(ModelError, match="drive_angle"):
-            _chain(2, plate_motion=1, drive_angle=angle)
+            chain_of(2, plate_motion=1, drive_angle=angle)
     with pytest.raises(ModelError, match="rk4|symplectic_euler"):
-        _chain(2, plate_motion=1, integrator="adaptive")
+        chain_of(2, plate_motion=1, integrator="adaptive")
