@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from . import jitcache  # noqa: F401  (before numba: the kernel cache's folder and locator)
 from numba import carray, njit, types  # noqa: E402
-from numba.extending import intrinsic  # noqa: E402
+from numba.extending import intrinsic, overload  # noqa: E402
 
 
 @intrinsic
@@ -64,6 +64,33 @@ def unowned(array):
     the calls it is passed to take no atomic reference counts.  The caller keeps ``array``
     alive (``keep_alive``) for as long as the view is used."""
     return carray(_data_of(array), array.shape)
+
+
+def unowned_each(values):
+    """``values`` (a tuple) with each C-contiguous array in it replaced by its ``unowned``
+    view and every other item passed through (compiled code only)."""
+
+
+def _unowned_or_same(value):
+    """``unowned(value)`` for an array, ``value`` itself for anything else."""
+
+
+@overload(_unowned_or_same, inline="always")
+def _unowned_or_same_of(value):
+    if isinstance(value, types.Array):
+        return lambda value: unowned(value)
+    return lambda value: value
+
+
+@overload(unowned_each, inline="always")
+def _unowned_each_of(values):
+    if not isinstance(values, types.BaseTuple):
+        return lambda values: values
+    # One expression per item: numba builds the tuple from the items' own types.
+    items = ", ".join(f"_unowned_or_same(values[{i}])" for i in range(len(values))) + ","
+    scope = {"_unowned_or_same": _unowned_or_same}
+    exec(f"def each(values):\n    return ({items})", scope)
+    return scope["each"]
 
 
 @intrinsic

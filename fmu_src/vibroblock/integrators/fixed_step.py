@@ -37,7 +37,7 @@ from numba.extending import overload
 from ..dispatch import called
 from ..dynamics import contact, coulomb_bound, friction_rule
 from ..laws import friction_released, friction_spring_force, plate_moves_sideways
-from ..unowned import data_pointer
+from ..unowned import data_pointer, keep_alive, unowned_each
 from ..layout import (C_SLIPS, C_STEP, D_DT, D_OMEGA, D_T0, N_OBS, O_CONTACT, O_COS, O_DISSIPATED, O_E_NORMAL,
                       O_F, O_FRICTION, O_NORMAL, O_PENETRATION, O_PHI, O_PLATE_VX, O_PLATE_X, O_SLIPS, O_T, O_VX,
                       O_VZ, O_WORK, O_X, O_Z,
@@ -175,7 +175,10 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
     method = literally(method)
     prm, drv, cnt = data_pointer(prm), data_pointer(drv), data_pointer(cnt)
     t0, dt = drv[D_T0], drv[D_DT]
-    ctx = scheme_prepare(method, kind, flags, drv, prm, dt)
+    # The step reads the scheme's arrays (tables, scratch) through unowned views: a
+    # counted array passed to a step that is called, not inlined, costs atomic counts.
+    owned_ctx = scheme_prepare(method, kind, flags, drv, prm, dt)
+    ctx = unowned_each(owned_ctx)
     moving = plate_moves(drv)
     x, z, vx, vz, shear, friction_state = y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_FRICTION_STATE]
     phi, phi_c = y[Y_PHI], y[Y_PHI_C]
@@ -226,6 +229,7 @@ def advance(kind, method, flags, y, cnt, drv, prm, n_steps, track_energy):
         done += 1
         if (done & (FINITE_CHECK - 1)) == 0 and not is_finite_state(x, z, vx, vz, shear):
             return NON_FINITE
+    keep_alive(owned_ctx)
     if not is_finite_state(x, z, vx, vz, shear):
         return NON_FINITE
     y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], y[Y_F], y[Y_FRICTION_STATE] = x, z, vx, vz, shear, friction_state

@@ -4,7 +4,7 @@ import pytest
 from numba import njit
 from numba.core.errors import TypingError
 
-from vibroblock.unowned import data_pointer, keep_alive, row_pointer, unowned
+from vibroblock.unowned import data_pointer, keep_alive, row_pointer, unowned, unowned_each
 
 
 @njit
@@ -81,3 +81,30 @@ def test_an_unowned_view_of_a_strided_array_is_refused_at_compile_time():
     """Its data pointer would read the base array's elements, not the view's."""
     with pytest.raises(TypingError):
         _unowned_first(np.arange(12.0).reshape(3, 4)[:, ::2])
+
+
+@njit
+def _bump_each(owned):
+    """Writes through ``unowned_each``'s views of a tuple of arrays and a scalar."""
+    table, flags, scale = unowned_each(owned)
+    table[1, 2] += scale
+    flags[0] = not flags[0]
+    keep_alive(owned)
+    return scale
+
+
+def test_unowned_each_views_every_array_of_a_tuple_and_passes_the_rest():
+    table, flags = np.zeros((2, 3)), np.zeros(2, dtype=np.bool_)
+    assert _bump_each((table, flags, 2.5)) == 2.5
+    assert table.tolist() == [[0.0, 0.0, 0.0], [0.0, 0.0, 2.5]]
+    assert flags.tolist() == [True, False]
+
+
+@njit
+def _each_of_a_scalar(value):
+    return unowned_each(value)
+
+
+def test_unowned_each_passes_a_value_that_is_not_a_tuple():
+    """A scheme with no arrays hands its driver a plain number."""
+    assert _each_of_a_scalar(7) == 7

@@ -18,7 +18,7 @@ from numba import njit
 
 from ...dynamics import contact
 from ...laws import friction_energy, friction_integrated, friction_interface_slips, friction_spring_force, friction_stored
-from ...unowned import data_pointer, keep_alive, unowned
+from ...unowned import data_pointer, keep_alive, unowned, unowned_each
 from ...layout import (C_ACCEPTED, C_EVENTS, C_JACOBIANS, C_JUMPED, C_REJECTED, C_SLIPS, C_STEP, D_AMP, D_DT,
                        D_EXT_A, D_EXT_V, D_EXT_Z, D_OMEGA, D_T0, N_OBS, P_MAX_JUMP, P_RTOL, Y_DISSIPATED,
                        Y_E_NORMAL, Y_F, Y_FRICTION_STATE, Y_PHI, Y_PHI_C, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
@@ -222,7 +222,7 @@ def _try_jump(run, v, acc, ic, tm, clk, ws):
     drv = run[1]
     u = tm[T_U]
     owned = (np.empty(2), np.zeros(4, dtype=np.int64), np.zeros(4))
-    try_clk, tally, dq = unowned(owned[0]), unowned(owned[1]), unowned(owned[2])
+    try_clk, tally, dq = unowned_each(owned)
     try_clk[0], try_clk[1] = clk[0], clk[1]
     advance_clock(drv, try_clk, u, False)
     plan = (tm[T_PERIOD], tm[T_CAP], tm[T_H], ic[I_EXPLICIT] != 0)
@@ -452,9 +452,9 @@ def evolve(kind, y, cnt, drv, prm, n0, u_end, track_energy, out, costs):
     # The loop reads its scratch and state through unowned views: every view taken of a
     # counted array costs two atomic operations, a quarter of a step's time.
     owned = workspace()
-    ws = (unowned(owned[0]), unowned(owned[1]), unowned(owned[2]), unowned(owned[3]))
+    ws = unowned_each(owned)
     state = _start(run, y, cnt, n0, u_end, clk, ws)
-    v, acc, ic, tm = unowned(state[0]), unowned(state[1]), unowned(state[2]), unowned(state[3])
+    v, acc, ic, tm = unowned_each(state)
     status = OK
     while tm[T_U] < tm[T_END]:
         if ic[I_ACCEPTED] + ic[I_REJECTED] >= MAX_STEPS:

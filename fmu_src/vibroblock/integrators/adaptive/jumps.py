@@ -41,7 +41,7 @@ from ... import jitcache  # noqa: F401  (first: numba's cache folder and locator
 from numba import njit
 
 from ...layout import P_ATOL, P_KD, P_MAX_JUMP, P_RTOL, P_VD
-from ...unowned import keep_alive, unowned
+from ...unowned import keep_alive, unowned_each
 from .methods import EVENT_SAMPLES, growth, sample_state, shrink, step
 from .regimes import NS, NS_MOTION, NV, THETA, event_at, event_value, events_of, plate, rates, switch_values
 from .rodas4 import EPS, linearise
@@ -379,7 +379,7 @@ def stroboscopic(system, v, t_base, clk, u_end, plan, dq, tally, ws):
     """``jump_periods`` with its scratch allocated here and read through unowned views
     (a counted view costs two atomic operations, and the jumps take many)."""
     owned = (np.empty(STROBE_STEPS), np.zeros((STROBE_ROWS, NA)), np.zeros((3, NA, NA)), np.empty(2))
-    scratch = (unowned(owned[0]), unowned(owned[1]), unowned(owned[2]), unowned(owned[3]))
+    scratch = unowned_each(owned)
     jumped = jump_periods(system, v, t_base, clk, u_end, plan, (dq, tally, ws), scratch)
     keep_alive(owned)
     return jumped
