@@ -20,7 +20,7 @@ from .block import Block
 from .fmi import TIME_TOLERANCE, FmuFacade, PlateInputs, fmu_class
 from .interface import (CHOICES, DEFAULT_INTEGRATOR_TEXT, ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES,
                         OUTPUTS, reading_choices)
-from .jitcache import CORE_DIGEST, PACKAGE_DIR, core_digest
+from .jitcache import CORE_DIGEST, PACKAGE_DIR, SHIPPED_KERNELS, core_digest, seed_cache
 from .integrators import INTEGRATORS
 from .models import offered_by, variant
 from .native import NativeStep
@@ -124,6 +124,10 @@ class BlockFacade(PlateInputs, FmuFacade):
         if not bundled.is_dir() or bundled.resolve() == PACKAGE_DIR:
             return True
         if core_digest(bundled) == CORE_DIGEST:
+            # The same core imported from elsewhere (the harness imports it from the
+            # checkout) has no shipped kernels beside it: seed the cache from the FMU's,
+            # or each new process compiles the default integrator at its first doStep.
+            seed_cache(Path(resources) / SHIPPED_KERNELS.name)
             return True
         self.log(f"this process already imported a different vibroblock core from {PACKAGE_DIR}; "
                  f"the FMU's own core is {bundled}. Run the FMU in a process without that import.",
