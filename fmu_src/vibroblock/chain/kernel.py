@@ -31,6 +31,8 @@ spring k_p, and a coupling spring's stretch is the difference of two displacemen
 """
 import math
 
+import numpy as np
+
 from .. import jitcache  # noqa: F401  (first: numba's cache folder and locator)
 from numba import njit
 
@@ -41,9 +43,11 @@ from ..integrators.plate import (drive_sin_cos, frame_force, next_sin_cos, phase
 from ..integrators.rk4 import stage_rates
 from ..integrators.symplectic_euler import euler_step
 from ..laws import plate_moves_sideways
+from ..models import MODELS
+from ..readings import encode
 from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_M, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
                       Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
-from ..unowned import data_pointer, row_pointer
+from ..unowned import data_pointer, keep_alive, row_pointer, unowned
 from .clusters import close, follow
 
 # The chain's own constants, float64 array ``chn``: coupling stiffness, periodic ends
@@ -53,17 +57,25 @@ from .clusters import close, follow
 H_KC, H_PERIODIC, H_V_START, H_V_STOP, H_CLUSTERS, H_SCHEME = range(6)
 N_CHN = 6
 SYMPLECTIC_EULER, RK4 = 0, 1
+# The chain's default physics (model A, every reading and law at its default): its
+# symplectic Euler pass is compiled with this kind as a constant, so that every law's
+# dispatch folds away; any other kind runs the same pass branching on its bits.  (A numpy
+# integer, not a Python one: numba takes it as a plain int64 constant, so the laws' other
+# branches, dead after LLVM's folding, compile no extra version of their called functions.)
+DEFAULT_KIND = np.int64(encode(MODELS["A"]))
 # The open event and the catalogue's bookkeeping, float64 array ``evt``: an event is open
 # (1.0), its start time, first block, peak slip speed; events closed in all, rows of the
 # catalogue filled since the runner last emptied it, and the last event's potency.
 E_OPEN, E_START, E_FIRST, E_PEAK, E_CLOSED, E_ROWS, E_LAST = range(7)
 N_EVT = 7
-# Per-block scratch, float64 array (N, N_SCRATCH): the coupling force of this step, the
-# position before it, the position when the open event started, whether the block has
-# slipped in the open event, the Coulomb resets of the block so far, and for the cluster
-# catalogue the block's cluster now (slot + 1, 0 for none); for rk4 the block's position
-# at the current stage, its rates there (``rk4.stage_rates``: x, z, vx, vz, F, phi, work,
-# dissipation, normal spring) and their weighted sum over the stages so far.
+# Per-block scratch, float64 array (N, N_SCRATCH): a slot no longer written (it held the
+# coupling force, which the step's pass now computes in place; kept so that saved states
+# keep their layout), the position before the step, the position when the open event
+# started, whether the block has slipped in the open event, the Coulomb resets of the
+# block so far, and for the cluster catalogue the block's cluster now (slot + 1, 0 for
+# none); for rk4 the block's position at the current stage, its rates there
+# (``rk4.stage_rates``: x, z, vx, vz, F, phi, work, dissipation, normal spring) and their
+# weighted sum over the stages so far.
 S_PUSH, S_X_BEFORE, S_X_AT_START, S_JOINED, S_RESETS, S_LABEL, S_STAGE_X = range(7)
 N_RATES = 9
 S_RATES = S_STAGE_X + 1
@@ -77,26 +89,75 @@ CATALOGUE_FULL = 2  # a status: the steps so far are stored; empty the catalogue
 
 
 @njit(inline="always")
-def pull_on(positions, i, periodic):
-    """x_left - x + x_right - x of block i (free ends: no neighbour, no spring)."""
-    n_blocks = positions.shape[0]
-    x, pull = positions[i], 0.0
+def pull_on(scratch, column, i, periodic):
+    """x_left - x + x_right - x of block i, the positions in ``column`` of the per-block
+    scratch (free ends: no neighbour, no spring).  Indexed in place, not through a
+    column view: a view taken per block costs two atomic reference counts."""
+    n_blocks = scratch.shape[0]
+    x, pull = scratch[i, column], 0.0
     if i > 0 or periodic:
-        pull += positions[(i - 1) % n_blocks] - x
+        pull += scratch[i - 1 if i > 0 else n_blocks - 1, column] - x
     if i < n_blocks - 1 or periodic:
-        pull += positions[(i + 1) % n_blocks] - x
+        pull += scratch[i + 1 if i < n_blocks - 1 else 0, column] - x
     return pull
 
 
 @njit(inline="always")
-def couple(Y, chn, scratch):
-    """Each block's coupling force k_c (x_left - x + x_right - x) from the positions now;
-    and the positions, kept as the positions before the step."""
-    periodic = chn[H_PERIODIC] != 0.0
+def euler_sweep(kind, drv, Y, PRM, chn, scratch, clock, plate, drive, following, track_energy):
+    """One symplectic Euler step of every block in a single pass over the chain: each
+    block's coupling k_c (x_left - x + x_right - x) from the positions at the step's start
+    (its right neighbour is not stepped yet, its left one's position was kept on the way),
+    its step (``step_block``), and what the catalogue needs of its new slip speed.  One
+    pass, not one per task: the per-block rows are read once per step, and no index
+    wraps around by a division (periodic ends take the two end positions kept before
+    the pass).  ``clock`` = (t, t + h, h); ``plate`` = (height, velocity) at t and t + h;
+    ``drive`` = the drive's (sin, cos) at t, for the oblique plate's frame force;
+    ``following``: an open chain-wide event, whose slipping blocks the pass marks.
+    Returns (the first block slipping faster than v_start, -1 if none; whether any slips
+    at v_stop or faster; the largest slip speed)."""
+    t = clock[0]
+    n_blocks = Y.shape[0]
+    k_c, periodic, v_start, v_stop = chn[H_KC], chn[H_PERIODIC] != 0.0, chn[H_V_START], chn[H_V_STOP]
+    sideways = plate_moves_sideways(kind)
+    first_before, left = Y[0, Y_X], Y[n_blocks - 1, Y_X]  # (block 0's left neighbour under periodic ends)
+    first, moving, peak = -1, False, 0.0
+    for i in range(n_blocks):
+        prm, y, own = row_pointer(PRM, i), row_pointer(Y, i), row_pointer(scratch, i)
+        x = y[Y_X]
+        right = Y[i + 1, Y_X] if i + 1 < n_blocks else first_before
+        pull = 0.0  # (summed as pull_on sums it: a lone block's 0.0 adds nothing to its push)
+        if i > 0 or periodic:
+            pull += left - x
+        if i < n_blocks - 1 or periodic:
+            pull += right - x
+        own[S_X_BEFORE] = left = x
+        frame = frame_force(kind, drv, prm, drive[0], drive[1], t) if sideways else 0.0
+        own[S_RESETS] = step_block(kind, prm, y, clock, plate, (k_c * pull, frame), own[S_RESETS], track_energy)
+        speed = abs(y[Y_VX])
+        if speed > v_start:
+            first = i if first < 0 else first
+            if following:
+                own[S_JOINED] = 1.0
+        moving = moving or speed >= v_stop
+        peak = max(peak, speed)
+    return first, moving, peak
+
+
+@njit(inline="always")
+def slip_survey(Y, chn, scratch, following):
+    """``euler_sweep``'s findings on the slip speeds after a step taken by another
+    scheme (rk4): the first block faster than v_start (-1: none), whether any slips at
+    v_stop or faster, the largest speed; an open event's slipping blocks are marked."""
+    first, moving, peak = -1, False, 0.0
     for i in range(Y.shape[0]):
-        scratch[i, S_X_BEFORE] = Y[i, Y_X]
-    for i in range(Y.shape[0]):
-        scratch[i, S_PUSH] = chn[H_KC] * pull_on(scratch[:, S_X_BEFORE], i, periodic)
+        speed = abs(Y[i, Y_VX])
+        if speed > chn[H_V_START]:
+            first = i if first < 0 else first
+            if following:
+                scratch[i, S_JOINED] = 1.0
+        moving = moving or speed >= chn[H_V_STOP]
+        peak = max(peak, speed)
+    return first, moving, peak
 
 
 @njit(inline="always")
@@ -159,23 +220,22 @@ def rk4_stage(kind, drv, Y, PRM, chn, scratch, stage, clock, plate, track_energy
         scratch[i, S_STAGE_X] = Y[i, Y_X] + offset * scratch[i, S_RATES] if stage > 0 else Y[i, Y_X]
     periodic = chn[H_PERIODIC] != 0.0
     for i in range(Y.shape[0]):
-        prm = row_pointer(PRM, i)
-        rates = scratch[i, S_RATES:S_RATES + N_RATES]
+        prm, own = row_pointer(PRM, i), row_pointer(scratch, i)
         state = (Y[i, Y_X], Y[i, Y_Z], Y[i, Y_VX], Y[i, Y_VZ], Y[i, Y_F])
         if stage > 0:  # (the first stage at the state itself, to the bit)
-            state = (scratch[i, S_STAGE_X], state[1] + offset * rates[1], state[2] + offset * rates[2],
-                     state[3] + offset * rates[3], state[4] + offset * rates[4])
+            state = (own[S_STAGE_X], state[1] + offset * own[S_RATES + 1], state[2] + offset * own[S_RATES + 2],
+                     state[3] + offset * own[S_RATES + 3], state[4] + offset * own[S_RATES + 4])
         frame = frame_force(kind, drv, prm, plate[2], plate[3], plate[4]) if sideways else 0.0
         new = stage_rates(kind, prm, state[0], state[1], state[2], state[3], state[4], t + offset, plate[0],
                           plate[1], frame, track_energy)
-        push = chn[H_KC] * pull_on(scratch[:, S_STAGE_X], i, periodic)
+        push = chn[H_KC] * pull_on(scratch, S_STAGE_X, i, periodic)
         weight = STAGE_WEIGHTS[stage]
         for k in range(N_RATES):
             value = new[k]
             if k == 2 and push != 0.0:  # (a lone block adds nothing, not even the sign of a zero)
                 value += push / prm[P_M]
-            rates[k] = value
-            scratch[i, S_SUM + k] = value if stage == 0 else scratch[i, S_SUM + k] + weight * value
+            own[S_RATES + k] = value
+            own[S_SUM + k] = value if stage == 0 else own[S_SUM + k] + weight * value
 
 
 @njit(inline="always")
@@ -195,44 +255,42 @@ def rk4_step(kind, drv, Y, PRM, chn, scratch, clock, plates, track_energy):
     rk4_stage(kind, drv, Y, PRM, chn, scratch, 3, (t, span), end, track_energy)
     sixth = span / 6.0
     for i in range(Y.shape[0]):
-        prm, y = row_pointer(PRM, i), row_pointer(Y, i)
-        sums = scratch[i, S_SUM:S_SUM + N_RATES]
+        prm, y, own = row_pointer(PRM, i), row_pointer(Y, i), row_pointer(scratch, i)
+        sums = (own[S_SUM], own[S_SUM + 1], own[S_SUM + 2], own[S_SUM + 3], own[S_SUM + 4], own[S_SUM + 5],
+                own[S_SUM + 6], own[S_SUM + 7], own[S_SUM + 8])
         x, z = y[Y_X] + sixth * sums[0], y[Y_Z] + sixth * sums[1]
         vx, vz, shear = y[Y_VX] + sixth * sums[2], y[Y_VZ] + sixth * sums[3], y[Y_F] + sixth * sums[4]
         contact1 = contact(kind, x, z, vx, vz, pz1, pv1, prm)
-        scratch[i, S_RESETS] = finish_block(kind, prm, y, (x, z, vx, vz, shear), contact1, (t1, h),
-                                            (sixth * sums[5], sixth * sums[6], sixth * sums[7], sixth * sums[8]),
-                                            scratch[i, S_RESETS], track_energy)
+        own[S_RESETS] = finish_block(kind, prm, y, (x, z, vx, vz, shear), contact1, (t1, h),
+                                     (sixth * sums[5], sixth * sums[6], sixth * sums[7], sixth * sums[8]),
+                                     own[S_RESETS], track_energy)
 
 
 @njit(inline="always")
-def open_event(Y, evt, scratch, v_start, t):
-    """Open an event if a block's slip speed exceeds v_start: its first such block, the
-    positions before the step as the event's start."""
-    for first in range(Y.shape[0]):
-        if abs(Y[first, Y_VX]) > v_start:
-            evt[E_OPEN], evt[E_START], evt[E_FIRST], evt[E_PEAK] = 1.0, t, first, 0.0
-            for i in range(Y.shape[0]):
-                scratch[i, S_X_AT_START], scratch[i, S_JOINED] = scratch[i, S_X_BEFORE], 0.0
-            return
-
-
-@njit(inline="always")
-def catalogue(Y, chn, evt, scratch, rows, t, t1):
-    """After a step from t to t1: open an event, follow the open one (which blocks slip,
-    its peak speed), and close it into the next row of ``rows`` once every block's slip
-    speed is below v_stop.  Returns CATALOGUE_FULL when the last row was filled."""
-    if evt[E_OPEN] == 0.0:
-        open_event(Y, evt, scratch, chn[H_V_START], t)
-        if evt[E_OPEN] == 0.0:
-            return OK
-    moving = False
+def open_event(Y, evt, scratch, v_start, first, t):
+    """Open an event at block ``first``, the first whose slip speed exceeds v_start: the
+    positions before the step as the event's start, and the blocks slipping now as its
+    first members."""
+    evt[E_OPEN], evt[E_START], evt[E_FIRST], evt[E_PEAK] = 1.0, t, first, 0.0
     for i in range(Y.shape[0]):
-        speed = abs(Y[i, Y_VX])
-        if speed > chn[H_V_START]:
-            scratch[i, S_JOINED] = 1.0
-        moving = moving or speed >= chn[H_V_STOP]
-        evt[E_PEAK] = max(evt[E_PEAK], speed)
+        scratch[i, S_X_AT_START] = scratch[i, S_X_BEFORE]
+        scratch[i, S_JOINED] = 1.0 if abs(Y[i, Y_VX]) > v_start else 0.0
+
+
+@njit(inline="always")
+def catalogue(Y, chn, evt, scratch, rows, survey, clock):
+    """After a step from t to t1 (``clock``) whose slip speeds the pass surveyed
+    (``survey``: ``euler_sweep``'s findings, the open event's slipping blocks marked):
+    open an event, follow the open one's peak speed, and close it into the next row of
+    ``rows`` once every block's slip speed is below v_stop.  Returns CATALOGUE_FULL when
+    the last row was filled."""
+    first, moving, peak = survey
+    t, t1 = clock
+    if evt[E_OPEN] == 0.0:
+        if first < 0:
+            return OK
+        open_event(Y, evt, scratch, chn[H_V_START], first, t)
+    evt[E_PEAK] = max(evt[E_PEAK], peak)  # (the largest of the speeds, in any order)
     if moving:
         return OK
     potency, joined = 0.0, 0.0
@@ -267,13 +325,18 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
     steps taken so far are stored: empty ``rows`` and call again) or NON_FINITE (the
     arrays are then partly advanced: the runner restores its copy)."""
     drv, cnt, chn = data_pointer(drv), data_pointer(cnt), data_pointer(chn)
+    # The per-block arrays through views numba does not count: handed to the step's
+    # functions, the counted arrays cost atomic counts at every step (a chain of one
+    # block took 117 ns per step with them, 19 without).
+    owned = (Y, PRM, evt, scratch, rows, clu)
+    Y, PRM, evt, scratch = unowned(Y), unowned(PRM), unowned(evt), unowned(scratch)
+    rows, clu = unowned(rows), unowned(clu)
     t0, dt = drv[D_T0], drv[D_DT]
     moving = plate_moves(drv)
     n = cnt[C_STEP]
     rot_s, rot_c = math.sin(drv[D_OMEGA] * dt), math.cos(drv[D_OMEGA] * dt)
     half_s, half_c = math.sin(0.5 * drv[D_OMEGA] * dt), math.cos(0.5 * drv[D_OMEGA] * dt)
     rk4 = chn[H_SCHEME] == RK4
-    sideways = plate_moves_sideways(kind)
     s, c = drive_sin_cos(drv, cnt, n)
     t = t0 + n * dt
     pz0, pv0 = plate_at(drv, s, c, t)
@@ -289,29 +352,32 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
                 pzh, pvh = plate_at(drv, s_half, c_half, t + 0.5 * dt)
             s, c = next_sin_cos(drv, cnt, n1, s, c, rot_s, rot_c)
             pz1, pv1 = plate_at(drv, s, c, t1)
+        chain_wide = chn[H_CLUSTERS] == 0.0
+        following = chain_wide and evt[E_OPEN] != 0.0
         if rk4:
             rk4_step(kind, drv, Y, PRM, chn, scratch, (t, t1, dt, t1 - t),
                      ((pz0, pv0, s0, c0, t), (pzh, pvh, s_half, c_half, t + 0.5 * dt), (pz1, pv1, s, c, t1)),
                      track_energy)
+            survey = slip_survey(Y, chn, scratch, following) if chain_wide else (-1, False, 0.0)
+        elif kind == DEFAULT_KIND:  # the same pass with every law's branch settled at compile time
+            survey = euler_sweep(DEFAULT_KIND, drv, Y, PRM, chn, scratch, (t, t1, dt), (pz0, pv0, pz1, pv1),
+                                 (s0, c0), following, track_energy)
         else:
-            couple(Y, chn, scratch)
-            for i in range(Y.shape[0]):
-                prm = row_pointer(PRM, i)
-                frame = frame_force(kind, drv, prm, s0, c0, t) if sideways else 0.0
-                scratch[i, S_RESETS] = step_block(kind, prm, row_pointer(Y, i), (t, t1, dt), (pz0, pv0, pz1, pv1),
-                                                  (scratch[i, S_PUSH], frame), scratch[i, S_RESETS], track_energy)
-        if chn[H_CLUSTERS] != 0.0:
+            survey = euler_sweep(kind, drv, Y, PRM, chn, scratch, (t, t1, dt), (pz0, pv0, pz1, pv1), (s0, c0),
+                                 following, track_energy)
+        if chain_wide:
+            status = catalogue(Y, chn, evt, scratch, rows, survey, (t, t1))
+        else:
             status = cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1)
-        else:
-            status = catalogue(Y, chn, evt, scratch, rows, t, t1)
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         if status != OK:
             break
     cnt[C_STEP] = n
+    finite = True
     for i in range(Y.shape[0]):
-        if not math.isfinite(Y[i, Y_X] + Y[i, Y_Z] + Y[i, Y_VX] + Y[i, Y_VZ] + Y[i, Y_F]):
-            return NON_FINITE
-    return status
+        finite = finite and math.isfinite(Y[i, Y_X] + Y[i, Y_Z] + Y[i, Y_VX] + Y[i, Y_VZ] + Y[i, Y_F])
+    keep_alive(owned)
+    return status if finite else NON_FINITE
 
 
 @njit(cache=True)

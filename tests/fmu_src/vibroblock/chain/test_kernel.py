@@ -167,6 +167,72 @@ def test_a_full_catalogue_loses_no_event_and_changes_nothing(monkeypatch):
     assert small.outputs()["event_count"] == len(big.events)
 
 
+@pytest.mark.parametrize("periodic, amplitude", [(False, 0.3), (True, 0.0)], ids=["vibrated", "still-periodic"])
+def test_the_default_physics_compiled_as_constants_gives_the_bits_of_the_run_time_branches(periodic, amplitude):
+    """The default physics runs a pass compiled with its kind as a constant, every other
+    kind the same pass branching at run time.  contact_law = 1 is the default contact on
+    a flat plate (the same functions, docs: laws) under another kind: a coupled,
+    heterogeneous chain through stick-slip events gives the same bits either way, state,
+    catalogue and energy balance."""
+    chains = []
+    for contact_law in (0, 1):
+        chain = chain_of(12, periodic=periodic, energy_balance=True, mu_s_spread=0.3, load_spread=0.2, seed=3,
+                         contact_law=contact_law, **dict(VIBRATED, V_d=2e-2, A=amplitude))
+        chain.start()
+        chain.advance_to(6000.0)
+        chains.append(chain)
+    default, other = chains
+    assert default.settings.kind == 0 and other.settings.kind != 0
+    assert len(default.events) >= 5 and default.outputs()["coulomb_resets"] > 100
+    assert other.Y.tolist() == default.Y.tolist()
+    assert other.events == default.events
+    assert other.outputs() == default.outputs()
+
+
+def _catalogue_by_the_rule(chain, t_end):
+    """Step ``chain`` one grid step at a time and apply the chain-wide catalogue's rule
+    (docs/chain.md) to the slip speeds after each step: an event opens at the first step
+    with a block's |vx| > v_start (its start: that step's start and its positions then),
+    holds every block that exceeds v_start while it is open, and closes at the first step
+    after which every |vx| < v_stop, its potency the sum of its blocks' slips."""
+    v_start, v_stop = chain.chain_parameters["v_start"], chain.chain_parameters["v_stop"]
+    dt, events, event = chain.parameter("dt"), [], None
+    while chain.grid_time + dt <= t_end:
+        t, before = chain.grid_time, chain.x
+        chain.advance_to(t + dt)
+        speeds = np.abs(chain.slip_velocity)
+        if event is None and np.any(speeds > v_start):
+            event = {"start": t, "first": int(np.argmax(speeds > v_start)), "x": before, "peak": 0.0,
+                     "joined": np.zeros(chain.n_blocks, dtype=bool)}
+        if event is None:
+            continue
+        event["joined"] |= speeds > v_start
+        event["peak"] = max(event["peak"], float(speeds.max()))
+        if np.all(speeds < v_stop):
+            potency = 0.0
+            for i in np.flatnonzero(event["joined"]):  # (in the blocks' order, as the kernel sums)
+                potency += chain.x[i] - event["x"][i]
+            events.append((event["start"], chain.grid_time, float(event["first"]), float(event["joined"].sum()),
+                           potency, event["peak"]))
+            event = None
+    return events
+
+
+def test_the_catalogue_is_its_rule_applied_to_the_steps():
+    """The catalogue the step's pass keeps on the way equals the rule applied step by
+    step from outside to the same run (a chain stepped one grid step per call, which
+    changes nothing: the test of a full catalogue)."""
+    parameters = dict(VIBRATED, A=0.0, omega=0.0, V_d=5e-2)
+    reference = chain_of(8, mu_s_spread=0.3, seed=5, **parameters)
+    reference.start()
+    expected = _catalogue_by_the_rule(reference, 1500.0)
+    chain = chain_of(8, mu_s_spread=0.3, seed=5, **parameters)
+    chain.start()
+    chain.advance_to(reference.grid_time)
+    assert len(expected) >= 3 and any(event[3] > 1 for event in expected)
+    assert chain.events == reference.events == expected
+
+
 @pytest.mark.parametrize("law, tolerance", [({}, 1e-9), (RATE_STATE, 1e-12)], ids=["paper", "rate_state"])
 def test_with_rk4_the_energy_balance_closes_to_rounding_between_resets(law, tolerance):
     """Eight heterogeneous blocks through stick-slip events, no vibration: rk4 is one
