@@ -106,7 +106,8 @@ OBSERVED_OUTPUTS = {"x": L.O_X, "friction_force": L.O_FRICTION, "normal_force": 
                     "phi_integral": L.O_PHI, "penetration": L.O_PENETRATION, "work_input": L.O_WORK,
                     "energy_dissipated": L.O_DISSIPATED, "contact": L.O_CONTACT, "coulomb_resets": L.O_SLIPS,
                     "slip_count": L.O_SLIPS}
-# ... and in the model's own reading, where the state is the point itself.
+# ... and in the model's own reading, where the state is the point itself (in another
+# reading in fixed axes, all but the surface, which ``observation.as_point`` forms).
 OBSERVED_POINT = {"z": L.O_Z, "vx": L.O_VX, "vz": L.O_VZ, "surface_z": SURFACE_Z}
 
 
@@ -161,8 +162,10 @@ class NativeLink:
         """(value reference, observation slot or SURFACE_Z / ZERO) of each output a front
         end may read straight from the observation in this run."""
         sources = dict(OBSERVED_OUTPUTS)
-        if not maps_to_point(block.settings):  # else z, vx, vz come from observation.as_point
+        if not maps_to_point(block.settings):
             sources.update(OBSERVED_POINT)
+        elif not block.settings.tangent_frame:  # observation.as_point leaves the fixed axes' z, vx, vz as they are
+            sources.update({name: source for name, source in OBSERVED_POINT.items() if source != SURFACE_Z})
         if not block.energy_balance:
             sources["energy_residual"] = ZERO
         pairs = [(self.output_refs[name], source) for name, source in sources.items() if name in self.output_refs]

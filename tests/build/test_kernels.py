@@ -1,4 +1,5 @@
 """build/kernels.py: every integrator compiled once; each Block FMU ships its default's kernels only."""
+import io
 import os
 import subprocess
 import sys
@@ -76,12 +77,34 @@ def test_a_block_fmu_is_small_and_ships_only_its_defaults(fmu_path, model):
     assert fmu.stat().st_size <= MAX_FMU_BYTES
     shipped = _shipped(fmu)
     folder = kernels.kept_kernels(build_fmus.CORE)
-    expected = {path.relative_to(folder / job).as_posix() for job in kernels.shipped_jobs(model)
-                for path in kernels.entry_files(folder / job)}
-    assert shipped and set(shipped) == expected
+    jobs = kernels.shipped_jobs(model)
+    expected = {path.relative_to(folder / job).as_posix() for job in jobs
+                for path in kernels.entry_files(folder / job) if path.suffix == ".nbi"}
+    assert shipped and {name for name in shipped if name.endswith(".nbi")} == expected
+    for index in expected:
+        # Every shipped job's entries of this index are in the FMU's one index (the jobs'
+        # C entries share a source file), each with its data file and nothing else.
+        keys = set()
+        for job in jobs:
+            if (folder / job / index).is_file():
+                keys |= set(_overloads((folder / job / index).read_bytes()))
+        overloads = _overloads(shipped[index])
+        assert set(overloads) == keys
+        data = {name for name in shipped if name.startswith(index[:-len("nbi")]) and name.endswith(".nbc")}
+        assert data == {f"{Path(index).parent.as_posix()}/{name}" for name in overloads.values()}
+    assert all(name.endswith(".nbi") or name[:name.rindex(".", 0, -4)] + ".nbi" in expected for name in shipped)
     compiled = {path.relative_to(folder / job).as_posix() for job in kernels.kernel_jobs()
                 for path in (folder / job).rglob("*.nbi")}
     assert compiled - expected, "every kernel shipped: the defaults are not told apart"
+
+
+def _overloads(index: bytes) -> dict:
+    """{key: data file} of a numba cache index (its version, then the source stamp and the overloads)."""
+    import pickle
+
+    stream = io.BytesIO(index)
+    pickle.load(stream)
+    return pickle.loads(stream.read())[1]
 
 
 @pytest.mark.parametrize("model", _models())
