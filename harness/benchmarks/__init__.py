@@ -52,15 +52,19 @@ def commit() -> str:
 
 def machine() -> str:
     """CPU count and model name, e.g. ``2 CPUs, Intel(R) Xeon(R) ...``."""
-    model = platform.processor() or platform.machine()
+    model = cpu_info("model name") or platform.processor() or platform.machine()
+    return f"{os.cpu_count() or '?'} CPUs, {model}"
+
+
+def cpu_info(field: str) -> str | None:
+    """The first core's ``field`` in /proc/cpuinfo (e.g. "model name", "cpu MHz"), or None."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
+            if line.startswith(field):
+                return line.split(":", 1)[1].strip()
     except OSError:
         pass
-    return f"{os.cpu_count() or '?'} CPUs, {model}"
+    return None
 
 
 def header(command: str | None = None, when: datetime.date | None = None) -> str:

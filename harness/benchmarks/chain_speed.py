@@ -44,7 +44,7 @@ from vibroblock import Block
 from vibroblock.chain import Chain
 from vibroblock.chain.runner import BLOCK_DEFAULTS
 
-from . import ROOT, recorded
+from . import ROOT, cpu_info, recorded
 from .build_cost import CORE, SpeedChild, previous_core
 
 SPREAD = {"mu_s_spread": 0.3, "seed": 1}
@@ -75,12 +75,9 @@ for line in sys.stdin:
 def clock_hz() -> float:
     """The core's clock as /proc/cpuinfo states it (nan where it does not)."""
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("cpu MHz"):
-                return float(line.split(":", 1)[1]) * 1e6
-    except (OSError, ValueError):
-        pass
-    return float("nan")
+        return float(cpu_info("cpu MHz")) * 1e6
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def ceiling() -> float:
