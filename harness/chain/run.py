@@ -18,6 +18,15 @@ import numpy as np
 from ..ground.excitation import simulate_block
 from .catalog import read_catalog
 
+# Carlson and Langer's standard parameters (l = 10, alpha = 2.5, sigma = 0.01, nu = 0.01;
+# Carlson, Langer and Shaw, Rev. Mod. Phys. 66, 657, 1994) in the chain's units
+# (docs/chain.md): mu_k = (1 - sigma) mu_s, v_w = (1 - sigma) v_1 / (2 alpha) and
+# V_d = nu v_1 with the velocity unit v_1 = mu_s m g omega_p / k_p = 5; the chain's
+# k_c = 1, k_p = 1e-2 give l^2 = 100.  gamma_t = 0.2 damps the ringing of a re-stuck
+# block within a few tau_0; mu_s spread by 5 %.
+CARLSON_LANGER = {"friction_law": 2, "mu_k": 0.495, "v_w": 0.99, "V_d": 0.05, "gamma_t": 0.2, "mu_s_spread": 0.05,
+                  "seed": 1}
+
 AGGREGATES = ("mean_slip_velocity", "moment_rate", "slipping_fraction", "event_count", "last_event_potency",
               "coulomb_resets")
 

@@ -18,14 +18,14 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from typing import Sequence
 
 from . import (c1_rest, c2_below_g, c3_onset, c4_hysteresis, c5_corrugated_plate, c6_recovery,
-               c6r_recovery_question, c7_contact, c8_drive_velocity, fig1b, fig1c_paper)
+               c6r_recovery_question, c7_contact, c8_drive_velocity, chain, fig1b, fig1c_paper)
 from .readings import DEFAULT_READING, READINGS, Reading, law_readings, split_study_name, study_name
 from .measure import friction_held, onset_amplitude, recovery, stable_roots_near, transition_bracket
 from .study import RESOLUTIONS, Claim, Resolution, Runner, Study, counts, load_studies, save_studies, timing
 
 CLAIMS: dict[str, Claim] = {module.CLAIM.name: module.CLAIM for module in (
     fig1b, c1_rest, c2_below_g, c3_onset, fig1c_paper, c4_hysteresis, c5_corrugated_plate, c6_recovery, c6r_recovery_question,
-    c7_contact, c8_drive_velocity)}
+    c7_contact, c8_drive_velocity, chain)}
 STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 
 
@@ -39,7 +39,7 @@ STUDIES = {name: claim.study for name, claim in CLAIMS.items()}
 # the compute time of each claim's study under one reading in the main job at the default
 # resolution (docs/benchmarks.md, section "make run"; Fig. 1c's runs of the paper's drive
 # are the job's longest single tasks).
-COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "C8", "C3", "C4", "C7", "C5", "C2", "C1", "Fig1b")
+COSTLIEST_FIRST = ("C6", "Fig1c", "C6r", "Chain", "C8", "C3", "C4", "C7", "C5", "C2", "C1", "Fig1b")
 
 
 def priority(name: str) -> int:

@@ -90,6 +90,14 @@ class Resolution:
     fig1c_omegas: tuple = ()
     fig1c_amplitudes: tuple = ()
     fig1c_cycles: int = 2
+    # The chain study (harness.paper.claims.chain): the catalogue's chain length and
+    # duration (tau_0; ~1 CPU-minute at the default), and the periodic loading's
+    # acceleration amplitude (g), phases of the loading cycle and periods (tau_0).
+    chain_blocks: int = 256
+    chain_horizon: float = 1e5
+    chain_acceleration: float = 0.005
+    chain_phases: tuple = (0.3, 0.6, 0.9)
+    chain_periods: tuple = (10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0)
 
 
 RESOLUTIONS = {
@@ -114,14 +122,15 @@ RESOLUTIONS = {
         c6_ratios=(7.0, 14.29), c6_stiffnesses=(1.0, 2.0), c6_relative_omegas=(0.5, 2.0),
         c6_ramp=(5.0, 14.0, 40.0), c6_ramp_step=4_000.0, c7_omegas=(0.1, 1.0, 14.0, 40.0),
         contact_horizon=3_000.0, c8_velocities=(1e-2, 10.0), c8_omegas=(0.3, 3.0), ensemble_wavelengths=0.0,
-        readings=False),
+        readings=False, chain_blocks=64, chain_horizon=2e4, chain_phases=(0.3, 0.9), chain_periods=(10.0, 100.0, 1000.0)),
     "tiny": Resolution(
         name="tiny", horizon_a=6_000.0, c2_amplitudes=(0.0, 8.0), c3_omegas=(0.2, 2.0), c3_amplitudes=(0.1, 100.0),
         c4_gammas=(0.07, 0.28), c4_omegas=(0.25, 0.45), c4_step=3_000.0, b_horizon=8_000.0, b_amplitudes=(0.0, 5.0),
         c_horizon=3_000.0, c6_amplitudes=(3.0,), c6_omegas=(0.3, 14.0), c6_ratios=(14.29,), c6_stiffnesses=(1.0,),
         c6_relative_omegas=(0.5, 2.0), c6_ramp=(5.0, 30.0), c6_ramp_step=2_500.0, c7_omegas=(0.3, 14.0),
         contact_horizon=2_500.0, c8_velocities=(10.0,), c8_omegas=(0.3,), ensemble_wavelengths=0.0,
-        fig1c_omegas=(0.2,), fig1c_amplitudes=(0.3,), fig1c_cycles=1),
+        fig1c_omegas=(0.2,), fig1c_amplitudes=(0.3,), fig1c_cycles=1, chain_blocks=16, chain_horizon=5e3,
+        chain_phases=(0.6,), chain_periods=(10.0, 50.0, 1000.0, 2000.0)),
 }
 
 

@@ -48,7 +48,8 @@ def test_tiny_main_job_writes_a_report_from_its_measurements(tiny_job):
     c8b = next(r for r in rows if r.claim == "C8b")
     assert c8b.verdict == DISAGREES and "sign typo" in c8b.reason
     for name in ("fig1b.png", "fig1c_phase_diagram_A.png", "hysteresis_gamma_n.png", "model_b_x_t.png",
-                 "model_c_phase_diagram.png", "omega2_vs_k_n.png", "model_c_Vd_omega.png"):
+                 "model_c_phase_diagram.png", "omega2_vs_k_n.png", "model_c_Vd_omega.png", "chain_catalog.png",
+                 "chain_triggering.png"):
         assert (out / name).stat().st_size > 0 and f"]({name})" in text
     assert "phi_threshold: 10" in text and "transient: 4000" in text
     # The paper's Fig. 1c at the paper's own parameters: a sub-threshold point stick-slips
@@ -58,6 +59,10 @@ def test_tiny_main_job_writes_a_report_from_its_measurements(tiny_job):
     assert point["regime"] == "stick_slip" and point["slips_in_window"] >= fig1c.settings["cycles"] + 1
     assert (out / "fig1c_paper_parameters.png").stat().st_size > 0
     assert "- Fig1c: 1 points" in text
+    # The chain study: its catalogue ran through BlockChain3.fmu and the report states it.
+    chain = studies["Chain"].measured
+    assert chain["catalogue"]["events"] > 0 and f"gave {chain['catalogue']['events']} events" in text
+    assert "- Chain: a chain of blocks" in text
 
 
 def test_changed_measurement_changes_the_report(tiny_job):
