@@ -30,6 +30,18 @@ large one.  :func:`periodic_advance` keeps a :class:`Harmonic` plate
 acceleration a sin(2 pi tau / P) up until the event: the periodic loading of Perfettini
 et al.
 
+The threshold a(P) (:func:`threshold_sweep`): per phase and period, the smallest burst
+acceleration that triggers the next large event, bisected, beside what the static picture
+predicts: the amplitude at which the normal-force dip of a block held on the plate (the
+contact's linear response to the burst, which counts its resonance) brings the first
+block's Coulomb bound below the load its friction spring holds (:func:`predicted_threshold`).
+
+The threshold a(P) (:func:`threshold_sweep`): per phase and period, the smallest burst
+acceleration that triggers the next large event, bisected, beside what the static picture
+predicts: the amplitude at which the normal-force dip of a block held on the plate (the
+contact's linear response to the burst, which counts its resonance) brings the first
+block's Coulomb bound below the load its friction spring holds (:func:`predicted_threshold`).
+
 The burst is scaled by its acceleration: in contact the plate's acceleration changes the
 normal force, and with it the Coulomb bound mu_s N, by m a (the stress perturbation of
 Perfettini et al.); a burst of fixed height would perturb it by A (2 pi / P)^2, mixing
@@ -44,6 +56,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+import numpy as np
 
 from vibroblock.chain import Chain
 
@@ -359,3 +373,103 @@ RATE_STATE_STUDY = TriggerSettings(
     n_blocks=16, mu_s_spread=0.0, load_spread=0.3, seed=1, snapshot_interval=100.0, chunk=25.0,
     parameters=(("friction_law", 3), ("rs_a", 0.01), ("rs_b", 0.015), ("rs_D_c", 0.1), ("rs_V_0", 1e-2),
                 ("rs_mu_0", 0.5), ("rs_theta_0", 10.0), ("gamma_t", 0.05), ("v_start", 0.2), ("v_stop", 0.05)))
+
+
+# ---------------------------------------------------------------------- thresholds a(P)
+def trigger_threshold(reference: Reference, settings: TriggerSettings, phase: float, period: float,
+                      low: float = 1e-3, high: float = 1.0, rel: float = 0.02) -> dict:
+    """The smallest acceleration amplitude of a burst of period ``period`` at ``phase`` of
+    the reference cycle that triggers the next large event, bisected in log a between
+    ``low`` and ``high`` (in g) to a relative width ``rel``.  Returns the bracket
+    (``below``: a burst that did not trigger, ``above``: one that did; nan where
+    ``high`` did not trigger or ``low`` already did) and the runs it took.  The bisection
+    takes triggering to grow with a: it reports the bracket it found, not a proof that
+    no smaller a triggers."""
+    def triggers(acceleration):
+        return clock_advance(reference, settings, phase, period, acceleration)["triggered"]
+
+    runs = 2
+    if not triggers(high):
+        return {"phase": phase, "period": period, "below": high, "above": math.nan, "runs": 1}
+    if triggers(low):
+        return {"phase": phase, "period": period, "below": math.nan, "above": low, "runs": runs}
+    while high / low > 1.0 + rel:
+        middle = math.sqrt(low * high)
+        runs += 1
+        if triggers(middle):
+            high = middle
+        else:
+            low = middle
+    return {"phase": phase, "period": period, "below": low, "above": high, "runs": runs}
+
+
+def margins(chain: Chain, settings: TriggerSettings) -> tuple[float, float]:
+    """How far the plate must accelerate downwards, held, for the Coulomb bound
+    mu_s,i m (g_i - a) of the first block, and of half the blocks, to fall below the load
+    k_t |F_i| its friction spring holds now (every block at rest on the flat plate, so its
+    normal force is its weight)."""
+    from vibroblock import layout as L
+
+    p = chain.settings.parameters
+    load = p["k_t"] * np.abs(chain.Y[:, L.Y_F])
+    margin = np.sort(chain.PRM[:, L.P_G] - load / (chain.PRM[:, L.P_MUS] * p["m"]))
+    return float(margin[0]), float(margin[int(math.ceil(settings.large_fraction * chain.n_blocks)) - 1])
+
+
+def normal_force_dip(signal: PlateSignal, parameters: dict, sample_step: float):
+    """The normal force's drop below the weight, over m, of a block held on the plate
+    (the spring-dashpot contact m, k_n, gamma_n of ``parameters``, a base-excited linear
+    oscillator that never leaves the plate) while the plate moves by ``signal``: times
+    ``sample_step`` apart over the signal and the drops there (scipy's ``solve_ivp``,
+    rtol 1e-10)."""
+    from scipy.integrate import solve_ivp
+
+    m, k_n, gamma_n = parameters["m"], parameters["k_n"], parameters["gamma_n"]
+
+    def rates(tau, y):  # y: the block's height and velocity relative to the plate
+        return (y[1], -(k_n * y[0] + gamma_n * y[1]) / m - signal(tau)[2])
+
+    taus = np.linspace(0.0, signal.duration, int(round(signal.duration / sample_step)) + 1)
+    solution = solve_ivp(rates, (0.0, signal.duration), (0.0, 0.0), t_eval=taus, rtol=1e-10, atol=1e-12,
+                         max_step=2.0 * sample_step)
+    # The contact force is -k_n y - gamma_n y' over the weight's: its drop is their sum's negative.
+    return taus, (k_n * solution.y[0] + gamma_n * solution.y[1]) / m
+
+
+def predicted_threshold(reference: Reference, settings: TriggerSettings, phase: float, period: float) -> dict:
+    """The acceleration amplitude a burst needs, by the static picture, to bring the
+    Coulomb bound of the first block, and of half the blocks, below the load their springs
+    hold: the smallest margin(t_b + tau) / dip(tau) over the burst, the margins of the
+    undisturbed chain (:func:`margins`) and the dip of a unit burst's normal force
+    (:func:`normal_force_dip`), which counts the contact's resonance and ringing."""
+    t_b = reference.t_s + phase * reference.cycle
+    chain = restored(reference, settings, t_b)
+    signal = Burst(1.0, period, settings.cycles, settings.steps_per_period)
+    # 32 samples per period: the sampled peak is within cos(pi/32) (0.5 %) of the true one.
+    taus, dips = normal_force_dip(signal, chain.settings.parameters, period / 32.0)
+    first = half = math.inf
+    for tau, dip in zip(taus, dips):
+        if tau > 0.0:
+            chain.advance_to(t_b + tau)
+        if dip > 0.0:
+            m_first, m_half = margins(chain, settings)
+            first, half = min(first, m_first / dip), min(half, m_half / dip)
+    return {"phase": phase, "period": period, "first_block": first, "half_chain": half}
+
+
+def threshold_sweep(reference: Reference, settings: TriggerSettings, phases, periods, rel: float = 0.02) -> list[dict]:
+    """Per phase and period: the bisected threshold (:func:`trigger_threshold`) beside the
+    static prediction (:func:`predicted_threshold`).  Only bursts shorter than the time
+    left, ``cycles`` P < T_0: a longer one still plays when the undisturbed event comes,
+    and any perturbation that moves that event earlier would count as a trigger."""
+    rows = []
+    for phase in phases:
+        t0 = (1.0 - phase) * reference.cycle
+        for period in periods:
+            if settings.cycles * period >= t0:
+                continue
+            measured = trigger_threshold(reference, settings, phase, period, rel=rel)
+            predicted = predicted_threshold(reference, settings, phase, period)
+            rows.append({**measured, "T0": t0, "first_block": predicted["first_block"],
+                         "half_chain": predicted["half_chain"]})
+    return rows

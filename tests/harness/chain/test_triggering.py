@@ -155,3 +155,33 @@ def test_periodic_loading_starts_at_rest_and_its_acceleration_is_a_sine():
 def test_periodic_loading_of_no_amplitude_changes_nothing(reference):
     row = periodic_advance(reference, TriggerSettings(), 0.4, 50.0, 0.0)
     assert row["advance"] == 0.0 and row["t_event"] == reference.t_ref and row["smaller_events"] == 0
+
+
+def test_a_slow_bursts_normal_force_dip_is_the_plates_downward_acceleration():
+    """A burst far slower than the contact (P = 2000 against 2 pi sqrt(m/k_n) = 6.3): the
+    block follows the plate, so m times the plate's acceleration is all the normal force
+    changes by (to the contact's lag, (2 pi/P)^2 m/k_n ~ 1e-5)."""
+    from harness.chain.triggering import normal_force_dip
+
+    signal = Burst(1.0, 2000.0, 3, 64)
+    taus, dips = normal_force_dip(signal, {"m": 1.0, "k_n": 1.0, "gamma_n": 0.07}, 25.0)
+    plate = np.array([signal(tau)[2] for tau in taus])
+    assert np.max(np.abs(dips + plate)) < 1e-3 * np.max(np.abs(plate))
+
+
+@pytest.mark.parametrize("phase, period", [(0.9, 7.84), (0.6, 19.51), (0.9, 30.76)])
+def test_the_trigger_threshold_is_the_first_blocks_static_one(reference, phase, period):
+    """The bisected threshold of a burst brackets the static prediction for the first block:
+    the acceleration at which the contact's dip lowers its Coulomb bound below the load its
+    spring holds (to 3 %: the bracket's 2 % and the sampling).  Half the chain's static
+    threshold is several times higher: one block's slip sets off the large event."""
+    from harness.chain.triggering import predicted_threshold, trigger_threshold
+
+    settings = TriggerSettings()
+    bracket = trigger_threshold(reference, settings, phase, period)
+    assert not clock_advance(reference, settings, phase, period, bracket["below"])["triggered"]
+    assert clock_advance(reference, settings, phase, period, bracket["above"])["triggered"]
+    assert bracket["above"] / bracket["below"] <= 1.02
+    predicted = predicted_threshold(reference, settings, phase, period)
+    assert bracket["below"] / 1.03 <= predicted["first_block"] <= bracket["above"] * 1.03
+    assert predicted["half_chain"] > 2.5 * predicted["first_block"]
