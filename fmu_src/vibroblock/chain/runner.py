@@ -24,6 +24,7 @@ import numpy as np
 from .. import layout as L
 from .. import run_arrays
 from ..initial_state import place
+from ..laws import friction_law_parameters
 from ..observation import contact_energy, stored_energy
 from ..settings import ModelError, Settings
 from . import kernel as K
@@ -47,8 +48,21 @@ CHAIN_PARAMETERS = {
     "mu_s_spread": (0.0, "1", "heterogeneity: each block's mu_s is mu_s (1 + mu_s_spread u), u uniform in [-1, 1]"),
     "load_spread": (0.0, "1", "heterogeneity: each block's weight (its normal load) is m g (1 + load_spread u'), u' "
                               "uniform in [-1, 1], drawn after the mu_s draws"),
+    "rs_a_spread": (0.0, "1", "heterogeneity under rate-and-state friction: each block's rs_a is rs_a (1 + rs_a_spread "
+                              "u), u uniform in [-1, 1], drawn after the loads"),
+    "rs_b_spread": (0.0, "1", "heterogeneity under rate-and-state friction: each block's rs_b is rs_b (1 + rs_b_spread "
+                              "u), drawn after the rs_a draws"),
+    "rs_D_c_spread": (0.0, "1", "heterogeneity under rate-and-state friction: each block's rs_D_c is rs_D_c (1 + "
+                                "rs_D_c_spread u), drawn after the rs_b draws"),
     "seed": (0.0, "1", "seed of the heterogeneity's random draw (an integer)"),
 }
+# The heterogeneity: each spread and the block parameter it spreads, in the order of their
+# draws (each takes the generator's next N uniform draws, so adding one leaves the draws
+# of those before it as they were).
+SPREADS = (("mu_s_spread", "mu_s"), ("load_spread", "g"), ("rs_a_spread", "rs_a"), ("rs_b_spread", "rs_b"),
+           ("rs_D_c_spread", "rs_D_c"))
+# Spreads of a friction law's own parameters: only a law that has them takes them.
+LAW_SPREADS = ("rs_a", "rs_b", "rs_D_c")
 
 
 # The blocks' defaults where they differ from model A's: the loading of the single block's
@@ -129,6 +143,14 @@ class Chain:
             raise ModelError(f"mu_s_spread = {p['mu_s_spread']!r} must be in [0, 1): every mu_s stays positive")
         if not 0.0 <= p["load_spread"] < 1.0:
             raise ModelError(f"load_spread = {p['load_spread']!r} must be in [0, 1): every block keeps a weight")
+        law = friction_law_parameters(self.settings.readings)
+        for spread, name in SPREADS[2:]:
+            if not 0.0 <= p[spread] < 1.0:
+                raise ModelError(f"{spread} = {p[spread]!r} must be in [0, 1): every {name} keeps its sign")
+            if p[spread] > 0.0 and name not in law:
+                raise ModelError(f"{spread} = {p[spread]!r} spreads {name}, a parameter of rate-and-state friction "
+                                 f"(friction_law = 3 or 4); friction_law = {self.settings.readings['friction_law']} "
+                                 f"has no {name}")
         if p["seed"] != int(p["seed"]) or p["seed"] < 0:
             raise ModelError(f"seed = {p['seed']!r} must be a non-negative integer")
         # The coupling is one more spring on each block: the scheme's stability bound
@@ -150,7 +172,8 @@ class Chain:
         y, self.cnt, self.drv, prm = run_arrays.fresh(self.settings.parameters, t0, self.settings.readings)
         self.Y = np.ascontiguousarray(np.tile(y, (self.n_blocks, 1)))
         self.PRM = np.ascontiguousarray(np.tile(prm, (self.n_blocks, 1)))
-        self.PRM[:, L.P_MUS], self.PRM[:, L.P_G] = self.heterogeneity()
+        for name, values in self.drawn().items():
+            self.PRM[:, L.slot(name)] = values
         # Each block rests at its own weight's penetration, as a single block of that weight would.
         for i in range(self.n_blocks):
             place(self.settings, self.PRM[i], self.drv, self.Y[i])
@@ -171,22 +194,28 @@ class Chain:
         if self.catalog_file is not None:
             self.catalog_file.begin(self.describe_thresholds())
 
-    def heterogeneity(self) -> tuple[np.ndarray, np.ndarray]:
-        """Each block's mu_s and gravity: mu_s (1 + mu_s_spread u_i) and g (1 + load_spread u'_i),
-        u and u' the first and the next n_blocks uniform draws in [-1, 1] of numpy's
-        ``default_rng(seed)``.  Scaling g scales the block's weight m g, its only normal load
-        on model A's flat plate, and leaves its mass, so its inertia, as it is.  A spread of 0
-        leaves the model's value to the bit."""
+    def drawn(self) -> dict[str, np.ndarray]:
+        """Each block's value of every spread parameter (``SPREADS``): the model's value v
+        times (1 + spread u_i), u_1 ... u_N the next N uniform draws in [-1, 1] of numpy's
+        ``default_rng(seed)``, one batch per spread in ``SPREADS``' order, drawn whether the
+        spread is set or not (so each parameter's draws depend on the seed alone).  A
+        spread of 0 leaves the model's value to the bit.  Spreading g scales the block's
+        weight m g, its only normal load on model A's flat plate, and leaves its mass, so
+        its inertia, as it is."""
         p, n = self.chain_parameters, self.n_blocks
         rng = np.random.default_rng(int(p["seed"]))
-        mu_s_draw, load_draw = rng.uniform(-1.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
-        mu_s = np.full(n, self.settings.parameters["mu_s"])
-        gravity = np.full(n, self.settings.parameters["g"])
-        if p["mu_s_spread"] > 0.0:
-            mu_s *= 1.0 + p["mu_s_spread"] * mu_s_draw
-        if p["load_spread"] > 0.0:
-            gravity *= 1.0 + p["load_spread"] * load_draw
-        return mu_s, gravity
+        values = {}
+        for spread, name in SPREADS:
+            draw = rng.uniform(-1.0, 1.0, n)
+            values[name] = np.full(n, self.settings.parameters[name])
+            if p[spread] > 0.0:
+                values[name] *= 1.0 + p[spread] * draw
+        return values
+
+    def heterogeneity(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each block's mu_s and gravity (:meth:`drawn`)."""
+        drawn = self.drawn()
+        return drawn["mu_s"], drawn["g"]
 
     def set_velocities(self, vx) -> None:
         """Give the blocks these slip velocities at the start (a kick, e.g. along a normal

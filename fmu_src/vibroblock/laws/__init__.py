@@ -129,6 +129,12 @@ def law_parameters() -> tuple:
     return tuple(seen.values())
 
 
+def friction_law_parameters(readings: dict) -> tuple:
+    """The names of the chosen friction law's own parameters (e.g. rs_a under rate-and-state)."""
+    module = LAWS["friction"][int(readings.get("friction_law", 0))].module
+    return tuple(p.name for p in getattr(module, "PARAMETERS", ()))
+
+
 def initial_friction_state(readings: dict, parameters: dict) -> float:
     """The friction law's state at the start (``layout.Y_FRICTION_STATE``)."""
     module = LAWS["friction"][int(readings.get("friction_law", 0))].module

@@ -72,6 +72,26 @@ def test_uncoupled_blocks_with_spread_loads_are_single_blocks_of_those_weights()
     assert same_load.y[L.Y_Z] != runs[0]
 
 
+def test_uncoupled_blocks_with_spread_rate_state_parameters_are_single_blocks_of_those():
+    """k_c = 0, rate-and-state friction with a, b and D_c spread: each block is Block("A")
+    with its own a, b, D_c and weight, bit for bit (state slots and theta), on a vibrated
+    plate; the blocks' thetas part (the laws reach each block)."""
+    spreads = {"rs_a_spread": 0.3, "rs_b_spread": 0.4, "rs_D_c_spread": 0.5, "load_spread": 0.2}
+    chain = chain_of(3, k_c=0.0, seed=5, **VIBRATED, **RATE_STATE, **spreads)
+    chain.start()
+    chain.advance_to(1500.0)
+    drawn = chain.drawn()
+    assert all(len(set(drawn[name])) == 3 for name in ("rs_a", "rs_b", "rs_D_c"))
+    for i in range(3):
+        own = {name: float(drawn[name][i]) for name in ("rs_a", "rs_b", "rs_D_c", "g")}
+        block = Block("A", "symplectic_euler", 0, False, **{**VIBRATED, **RATE_STATE, **own})
+        block.start()
+        block.advance_to(1500.0)
+        assert chain.Y[i, :5].tolist() == block.y[:5].tolist()
+        assert chain.Y[i, L.Y_FRICTION_STATE] == block.y[L.Y_FRICTION_STATE]
+    assert len(set(chain.Y[:, L.Y_FRICTION_STATE].tolist())) == 3
+
+
 def _laplacian(n, periodic):
     lap = 2.0 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
     if periodic:

@@ -13,6 +13,9 @@ from vibroblock.settings import ModelError
     ({"mu_s_spread": 1.0}, "every mu_s stays positive"),
     ({"load_spread": 1.0}, "every block keeps a weight"),
     ({"seed": 1.5}, "non-negative integer"),
+    ({"friction_law": 3, "rs_D_c_spread": 1.0}, "every rs_D_c keeps its sign"),
+    ({"rs_a_spread": 0.2}, "rs_a_spread = 0.2 spreads rs_a, a parameter of rate-and-state friction"),
+    ({"friction_law": 2, "rs_b_spread": 0.1}, "friction_law = 2 has no rs_b"),
     ({"k_c": 1e4}, "too large for the coupling"),
 ])
 def test_settings_that_cannot_run_are_refused_at_the_start(settings, message):
@@ -37,6 +40,24 @@ def test_the_heterogeneity_is_the_seeded_draw_of_the_documented_distribution():
     assert again.gravity.tolist() == chain.gravity.tolist() and again.Y.tolist() == chain.Y.tolist()
     assert len(set(other.gravity.tolist()) & set(chain.gravity.tolist())) == 0
     assert mu_s_only.mu_s.tolist() == chain.mu_s.tolist() and set(mu_s_only.gravity.tolist()) == {1.0}
+
+
+def test_the_rate_state_spreads_draw_after_the_loads_and_leave_them_as_they_were():
+    """rs_a, rs_b, rs_D_c: the model's value (1 + spread u), u the third, fourth and fifth
+    batches of N draws of default_rng(seed), so spreading them leaves mu_s and g as they
+    were; each block's values reach its parameter row."""
+    n, law = 5, {"friction_law": 3, "rs_a": 0.01, "rs_b": 0.015, "rs_D_c": 0.1}
+    chain = Chain(n, mu_s_spread=0.2, load_spread=0.1, rs_a_spread=0.3, rs_b_spread=0.2, rs_D_c_spread=0.5, seed=4,
+                  **law)
+    chain.start()
+    draws = np.random.default_rng(4).uniform(-1.0, 1.0, 5 * n).reshape(5, n)
+    for k, (name, spread) in enumerate((("rs_a", 0.3), ("rs_b", 0.2), ("rs_D_c", 0.5)), start=2):
+        expected = (law[name] * (1.0 + spread * draws[k])).tolist()
+        assert chain.PRM[:, L.slot(name)].tolist() == expected, name
+    plain = Chain(n, mu_s_spread=0.2, load_spread=0.1, seed=4, **law)
+    plain.start()
+    assert plain.mu_s.tolist() == chain.mu_s.tolist() and plain.gravity.tolist() == chain.gravity.tolist()
+    assert set(plain.PRM[:, L.slot("rs_a")].tolist()) == {0.01}
 
 
 def test_each_block_starts_at_rest_under_its_own_weight():
