@@ -1,7 +1,7 @@
 """The chain's compiled step: N single blocks, each stepped by the single block's own
 scheme and laws, coupled by the springs between neighbours; and the event catalogue.
 
-Each block is a model-A block (``Settings("A", integrator)``): its slots of the
+Each block is a single block (``Settings(model, integrator)``, model A by default): its slots of the
 per-block arrays ``Y`` (state, ``layout.Y_*``) and ``PRM`` (parameters, with its own
 mu_s) are handed, as row pointers (``unowned.row_pointer``), to the functions the single
 block's schemes and driver call, and the driver's ``settle`` (friction rule,
@@ -378,6 +378,18 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
         finite = finite and math.isfinite(Y[i, Y_X] + Y[i, Y_Z] + Y[i, Y_VX] + Y[i, Y_VZ] + Y[i, Y_F])
     keep_alive(owned)
     return status if finite else NON_FINITE
+
+
+@njit(cache=True)
+def penetrations(kind, Y, PRM, plate_z):
+    """Each block's penetration as its contact sees it (``dynamics.contact``: on a
+    corrugated plate the depth below the surface along its normal), at the plate height
+    ``plate_z``: the runner books each block's contact energy from it, as the single
+    block does."""
+    out = np.empty(Y.shape[0])
+    for i in range(Y.shape[0]):
+        out[i] = contact(kind, Y[i, Y_X], Y[i, Y_Z], Y[i, Y_VX], Y[i, Y_VZ], plate_z, 0.0, PRM[i])[0]
+    return out
 
 
 @njit(cache=True)

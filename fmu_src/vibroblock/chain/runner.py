@@ -1,7 +1,9 @@
 """A chain of blocks on the vibrating plate (Burridge-Knopoff): the runner the
 BlockChain FMU and the harness drive, as ``Block`` is for one block.
 
-Every block is a model-A block with the single block's laws and scheme,
+Every block is a single block of model A (default; B or C with ``model``: the blocks sit a
+whole number of corrugation wavelengths apart, so the profile under block i is taken at
+its displacement x_i) with the single block's laws and scheme,
 ``symplectic_euler`` (default) or ``rk4`` (``chain.kernel``); the chain adds the
 coupling springs k_c between neighbours, a leaf spring k_p (the single block's drive
 spring k_d) per block, per-block mu_s and weights drawn from a seeded distribution, and
@@ -87,7 +89,7 @@ class Chain:
 
     def __init__(self, n_blocks: int = 16, *, periodic: bool = False, energy_balance: bool = False,
                  clusters: bool = False, catalog_path: str | Path | None = None,
-                 integrator: str | int = "symplectic_euler", **parameters):
+                 integrator: str | int = "symplectic_euler", model: str = "A", **parameters):
         if not (isinstance(n_blocks, (int, np.integer)) and n_blocks >= 1):
             raise ModelError(f"n_blocks = {n_blocks!r}: a chain has at least one block")
         self.n_blocks, self.periodic, self.energy_balance = int(n_blocks), bool(periodic), bool(energy_balance)
@@ -102,7 +104,7 @@ class Chain:
             else:
                 block["k_d" if name == "k_p" else name] = value
         self.started = False
-        self.settings = Settings("A", integrator, 0, self.energy_balance, **block)
+        self.settings = Settings(model, integrator, 0, self.energy_balance, **block)
         self.set_integrator(self.settings.integrator)
         self.catalog_file = CatalogFile(catalog_path) if catalog_path else None
         self.started = False
@@ -143,6 +145,10 @@ class Chain:
             raise ModelError(f"mu_s_spread = {p['mu_s_spread']!r} must be in [0, 1): every mu_s stays positive")
         if not 0.0 <= p["load_spread"] < 1.0:
             raise ModelError(f"load_spread = {p['load_spread']!r} must be in [0, 1): every block keeps a weight")
+        model = self.settings.model
+        for spread, name in SPREADS[:2]:
+            if p[spread] > 0.0 and name not in self.settings.parameters:
+                raise ModelError(f"{spread} = {p[spread]!r} spreads {name}, which model {model} does not have")
         law = friction_law_parameters(self.settings.readings)
         for spread, name in SPREADS[2:]:
             if not 0.0 <= p[spread] < 1.0:
@@ -187,8 +193,8 @@ class Chain:
         self.events: list[tuple] = []
         self.time = float(t0)
         plate_z = self.drv[L.D_AMP] * math.sin(self.drv[L.D_PHASE])  # (the drive's vertical part: A if vertical)
-        for i in range(self.n_blocks):
-            self.Y[i, L.Y_E_NORMAL] = contact_energy(self.settings, self.PRM[i], plate_z - self.Y[i, L.Y_Z])
+        for i, penetration in enumerate(K.penetrations(self.settings.kind, self.Y, self.PRM, plate_z)):
+            self.Y[i, L.Y_E_NORMAL] = contact_energy(self.settings, self.PRM[i], penetration)
         self.energy_at_start = self.stored_energy(plate_z)
         self.started = True
         if self.catalog_file is not None:
@@ -207,6 +213,8 @@ class Chain:
         values = {}
         for spread, name in SPREADS:
             draw = rng.uniform(-1.0, 1.0, n)
+            if name not in self.settings.parameters:  # (model C has no g: its load is P_l)
+                continue
             values[name] = np.full(n, self.settings.parameters[name])
             if p[spread] > 0.0:
                 values[name] *= 1.0 + p[spread] * draw
@@ -310,9 +318,9 @@ class Chain:
         plate_z = self.plate_height() if plate_z is None else plate_z
         Y, t, obs = self.Y, self.grid_time, np.zeros(L.N_OBS)
         total = 0.0
-        for i in range(self.n_blocks):
+        for i, penetration in enumerate(K.penetrations(self.settings.kind, Y, self.PRM, plate_z)):
             obs[L.O_X], obs[L.O_VX], obs[L.O_VZ], obs[L.O_F] = Y[i, L.Y_X], Y[i, L.Y_VX], Y[i, L.Y_VZ], Y[i, L.Y_F]
-            obs[L.O_PENETRATION] = plate_z - Y[i, L.Y_Z]
+            obs[L.O_PENETRATION] = penetration
             total += stored_energy(self.settings, self.PRM[i], obs, t)
         bonds = np.diff(Y[:, L.Y_X])
         if self.periodic and self.n_blocks > 1:  # (two blocks with periodic ends: two springs between them)
@@ -377,7 +385,7 @@ class Chain:
         if arrays["chn"].shape != (K.N_CHN,) or arrays["scratch"].shape != (n_blocks, K.N_SCRATCH):
             raise ModelError("not a valid chain state: its arrays have another layout (saved by another version "
                              "of the chain)")
-        self.settings = Settings.from_dict(state["settings"], "A")
+        self.settings = Settings.from_dict(state["settings"], self.settings.model)
         self.chain_parameters = dict(state["chain_parameters"])
         self.periodic, self.energy_balance = bool(state["periodic"]), bool(state["energy_balance"])
         self.clusters = bool(state["clusters"])

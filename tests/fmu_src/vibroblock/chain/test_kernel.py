@@ -39,6 +39,44 @@ def test_a_chain_of_one_block_is_the_single_block_bit_for_bit(law, integrator):
     assert chain.outputs()["coulomb_resets"] == block.counters["resets"]
 
 
+# A corrugated plate the block stick-slips over (wavelength 12.6 delta_0, slope up to 0.15),
+# followed over 2e4 tau_0 (the drive travels 16 wavelengths).
+CORRUGATION = {"A_x": 0.3, "omega_x": 0.5}
+
+
+@pytest.mark.parametrize("integrator", ["symplectic_euler", "rk4"])
+@pytest.mark.parametrize("model", ["B", "C"])
+def test_a_chain_of_one_block_on_a_corrugated_plate_is_the_single_block_bit_for_bit(model, integrator):
+    """Models B and C: the same profile, load, contact and friction per block, so every
+    state slot, the resets and the energy residual are Block(model)'s."""
+    block = Block(model, integrator, 0, True, **VIBRATED, **CORRUGATION)
+    chain = chain_of(1, model=model, energy_balance=True, integrator=integrator, **VIBRATED, **CORRUGATION)
+    run_side_by_side(block, chain, np.arange(1, 201) * 100.0)
+    assert block.counters["resets"] > 100 and block.y[L.Y_X] > 10 * 2 * math.pi / CORRUGATION["omega_x"]
+    assert chain.Y[0, :L.Y_E_START].tolist() == block.y[:L.Y_E_START].tolist()
+    assert chain.outputs()["energy_residual"] == block.outputs()["energy_residual"]
+    assert chain.outputs()["coulomb_resets"] == block.counters["resets"]
+
+
+def test_uncoupled_blocks_on_a_corrugated_plate_are_single_blocks_with_their_own_mu_s():
+    chain = chain_of(3, model="B", k_c=0.0, mu_s_spread=0.4, load_spread=0.3, seed=7, **VIBRATED, **CORRUGATION)
+    chain.start()
+    chain.advance_to(1500.0)
+    for i, (mu_s, gravity) in enumerate(zip(chain.mu_s, chain.gravity)):
+        block = Block("B", "symplectic_euler", 0, False, **{**VIBRATED, **CORRUGATION, "mu_s": float(mu_s),
+                                                            "g": float(gravity)})
+        block.start()
+        block.advance_to(1500.0)
+        assert chain.Y[i, :5].tolist() == block.y[:5].tolist()
+
+
+def test_model_c_has_no_weight_to_spread():
+    with pytest.raises(ModelError, match="load_spread = 0.2 spreads g, which model C does not have"):
+        Chain(3, model="C", load_spread=0.2).start()
+    with pytest.raises(ModelError, match="unknown model 'D'"):
+        Chain(3, model="D")
+
+
 def test_uncoupled_blocks_are_independent_single_blocks_with_their_own_mu_s():
     chain = chain_of(3, k_c=0.0, mu_s_spread=0.4, seed=7, **VIBRATED)
     chain.start()
