@@ -31,9 +31,12 @@ import sys
 import threading
 import traceback
 import weakref
+from pathlib import Path
 
 from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
+
+from .jitcache import CORE_DIGEST, PACKAGE_DIR, SHIPPED_KERNELS, core_digest, seed_cache
 
 _NAMESPACES_RELEASED_BY_LOADER: list = []
 # A doStep's communication point may differ from the FMU's time by this much relative
@@ -77,6 +80,25 @@ class FmuFacade(Fmi2Slave):
         super().__init__(**kwargs)
         self.start_time = 0.0
         _MADE_ON_THREAD[threading.get_ident()] = weakref.ref(self)
+
+    def _check_core(self, resources) -> bool:
+        """The process may already hold a vibroblock import (e.g. the harness): it must be
+        the core this FMU was built with, or results would silently come from other code."""
+        if resources is None:
+            return True
+        bundled = Path(resources) / "vibroblock"
+        if not bundled.is_dir() or bundled.resolve() == PACKAGE_DIR:
+            return True
+        if core_digest(bundled) == CORE_DIGEST:
+            # The same core imported from elsewhere (the harness imports it from the
+            # checkout) has no shipped kernels beside it: seed the cache from the FMU's,
+            # or each new process compiles the default integrator at its first doStep.
+            seed_cache(Path(resources) / SHIPPED_KERNELS.name)
+            return True
+        self.log(f"this process already imported a different vibroblock core from {PACKAGE_DIR}; "
+                 f"the FMU's own core is {bundled}. Run the FMU in a process without that import.",
+                 Fmi2Status.error)
+        return False
 
     # ------------------------------------------------------------------ hooks
     def _is_started(self) -> bool:

@@ -11,16 +11,14 @@ from __future__ import annotations
 
 import ctypes
 import math
-from pathlib import Path
 
-from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.variables import Boolean, Integer, Real
 
 from .block import Block
 from .fmi import TIME_TOLERANCE, FmuFacade, PlateInputs, fmu_class
 from .interface import (CHOICES, DEFAULT_INTEGRATOR_TEXT, ENERGY_BALANCE, INITIAL_CHOICES, INPUTS, INTEGRATOR_CHOICES,
                         OUTPUTS, reading_choices)
-from .jitcache import CORE_DIGEST, PACKAGE_DIR, SHIPPED_KERNELS, core_digest, seed_cache
 from .integrators import INTEGRATORS
 from .models import offered_by, variant
 from .native import NativeStep
@@ -114,25 +112,6 @@ class BlockFacade(PlateInputs, FmuFacade):
         if not self.block.started:
             return 0.0  # before initialization outputs are not yet calculated
         return self.block.output(name)
-
-    def _check_core(self, resources) -> bool:
-        """The process may already hold a vibroblock import (e.g. the harness): it must be
-        the core this FMU was built with, or results would silently come from other code."""
-        if resources is None:
-            return True
-        bundled = Path(resources) / "vibroblock"
-        if not bundled.is_dir() or bundled.resolve() == PACKAGE_DIR:
-            return True
-        if core_digest(bundled) == CORE_DIGEST:
-            # The same core imported from elsewhere (the harness imports it from the
-            # checkout) has no shipped kernels beside it: seed the cache from the FMU's,
-            # or each new process compiles the default integrator at its first doStep.
-            seed_cache(Path(resources) / SHIPPED_KERNELS.name)
-            return True
-        self.log(f"this process already imported a different vibroblock core from {PACKAGE_DIR}; "
-                 f"the FMU's own core is {bundled}. Run the FMU in a process without that import.",
-                 Fmi2Status.error)
-        return False
 
     def _apply_input(self) -> None:
         if self._input_changed:

@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import hashlib
 import itertools
 import json
 import math
@@ -52,7 +53,7 @@ import time
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence
+from typing import Callable, Iterable, Mapping, Sequence
 
 import dask
 import numpy as np
@@ -337,9 +338,12 @@ def _call_with_worker_pool(function, item):
     return function(item, plugin.pool)
 
 
-def map_with_pool(function, items: Sequence, execution: Execution = Execution(), client=None) -> list:
+def map_with_pool(function, items: Sequence, execution: Execution = Execution(), client=None,
+                  arrived: Callable[[int, object], None] | None = None) -> list:
     """``[function(item, pool) for item in items]`` in parallel, each call on a Dask worker
     with that worker's InstancePool (inline with ``scheduler="inline"``); results in order.
+    ``arrived(index, result)`` is called in this process as each result arrives (e.g. to
+    store it at once, so that an interrupted map loses no finished item).
 
     For work other than grid points, e.g. several continuation ramps at once::
 
@@ -347,8 +351,13 @@ def map_with_pool(function, items: Sequence, execution: Execution = Execution(),
     """
     items = list(items)
     if execution.scheduler == INLINE and client is None:
+        results = []
         with InstancePool(execution.cache) as pool:
-            return [function(item, pool) for item in items]
+            for index, item in enumerate(items):
+                results.append(function(item, pool))
+                if arrived is not None:
+                    arrived(index, results[-1])
+        return results
     own_client = client is None
     if own_client:
         client = open_client(execution)
@@ -356,11 +365,14 @@ def map_with_pool(function, items: Sequence, execution: Execution = Execution(),
         client.register_plugin(FmuPoolPlugin(execution.cache, execution.numba_cache()), name=POOL_PLUGIN)
         futures = [client.submit(_call_with_worker_pool, function, item, pure=False, priority=execution.priority)
                    for item in items]
+        index_of = {future.key: index for index, future in enumerate(futures)}
         bar = _progress(execution.progress, len(items), 0) if execution.progress else None
         try:
             from distributed import as_completed
 
-            for _ in as_completed(futures, loop=client.loop):
+            for future in as_completed(futures, loop=client.loop):
+                if arrived is not None and future.status == "finished":
+                    arrived(index_of[future.key], future.result())
                 _tick(bar)
         finally:
             if bar is not None:
@@ -369,6 +381,65 @@ def map_with_pool(function, items: Sequence, execution: Execution = Execution(),
     finally:
         if own_client:
             close_client(client)
+
+
+@dataclass(frozen=True)
+class _Timed:
+    """``function(item, pool)`` as ``{"result": ..., "elapsed_s": seconds}``, timed where
+    it runs (on a Dask worker, its own time, not the caller's wait)."""
+
+    function: Callable
+
+    def __call__(self, item, pool) -> dict:
+        started = time.perf_counter()
+        result = self.function(item, pool)
+        return {"result": result, "elapsed_s": time.perf_counter() - started}
+
+
+@dataclass
+class CachedOutcome:
+    results: list  # function(item, pool) per item, in order
+    computed: int
+    reused: int
+    compute_time: float  # seconds the computed items took where they ran
+
+
+def task_key(function: Callable, item, identity=None) -> str:
+    """The store key of ``function(item)``: sha256 of the canonical JSON of the function's
+    name, the item and ``identity`` (what else the result depends on, e.g. FMU hashes)."""
+    text = canonical_json({"function": f"{function.__module__}.{function.__qualname__}", "item": item,
+                           "identity": identity, "observables_version": OBSERVABLES_VERSION})
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def cached_map(function: Callable, items: Sequence[dict], folder: str | os.PathLike, identity=None,
+               execution: Execution = Execution(), client=None) -> CachedOutcome:
+    """``function(item, pool)`` for every item (:func:`map_with_pool`), each result kept in
+    ``folder`` as one JSON file (:func:`task_key`, with the seconds it took, ``elapsed_s``),
+    written as it arrives: items already in the folder are read, not computed, so a map
+    that was killed and started again computes only what had not finished."""
+    from .store import write_json_atomically
+
+    folder = Path(folder)
+    keys = [task_key(function, item, identity) for item in items]
+    results: dict[int, object] = {}
+    for number, key in enumerate(keys):
+        path = folder / f"{key}.json"
+        if path.exists():
+            results[number] = json.loads(path.read_text())["result"]
+    missing = [n for n in range(len(items)) if n not in results]
+    outcome = CachedOutcome([], len(missing), len(items) - len(missing), 0.0)
+
+    def arrived(index: int, timed: dict) -> None:
+        number = missing[index]
+        write_json_atomically(folder / f"{keys[number]}.json", {"item": to_jsonable(items[number]), **timed})
+        results[number] = timed["result"]
+        outcome.compute_time += timed["elapsed_s"]
+
+    if missing:
+        map_with_pool(_Timed(function), [items[n] for n in missing], execution, client, arrived)
+    outcome.results = [results[n] for n in range(len(items))]
+    return outcome
 
 
 def worker_pool_loads(client) -> dict[str, int]:

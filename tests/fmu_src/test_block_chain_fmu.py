@@ -89,6 +89,54 @@ def test_bad_settings_and_inputs_give_fmi2error_with_a_message(instance, fmu_log
     assert do_step(slave, 0.0, 100.0) == 0  # the instance goes on
 
 
+OTHER_CORE_SCRIPT = """
+import sys, zipfile
+import vibroblock  # the process holds the checkout's core, as the harness's do
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi1 import FMICallException
+source, other, folder = sys.argv[1], sys.argv[2], sys.argv[3]
+with zipfile.ZipFile(source) as zin, zipfile.ZipFile(other, "w", zipfile.ZIP_DEFLATED) as zout:
+    for item in zin.infolist():
+        data = zin.read(item)
+        if item.filename == "resources/vibroblock/layout.py":
+            data += b"\\n# a different core\\n"
+        zout.writestr(item, data)
+md = read_model_description(other)
+slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(other, unzipdir=folder),
+                  modelIdentifier=md.coSimulation.modelIdentifier, instanceName="other")
+slave.instantiate(loggingOn=True)
+for name, call in (("setupExperiment", lambda: slave.setupExperiment(startTime=0.0)),
+                   ("enterInitializationMode", slave.enterInitializationMode),
+                   ("exitInitializationMode", slave.exitInitializationMode),
+                   ("doStep", lambda: slave.doStep(0.0, 10.0))):
+    try:
+        call()
+        print(name, "ok", flush=True)
+    except FMICallException as exc:
+        print(name, "refused, status", exc.status, flush=True)
+slave.freeInstance()
+print("process still alive", flush=True)
+"""
+
+
+def test_a_chain_fmu_of_another_core_than_the_process_holds_refuses_to_start(chain_fmu, tmp_path):
+    """A process that imported the checkout's core (as the harness does) loads a
+    BlockChain.fmu whose bundled core differs: the FMU says so in its log and refuses to
+    initialize, rather than running the process's core under its own model description."""
+    import os
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", OTHER_CORE_SCRIPT, chain_fmu, str(tmp_path / "Other.fmu"),
+                           str(tmp_path / "other")], env=dict(os.environ), capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "different vibroblock core" in done.stdout
+    # No call runs the process's core in its place: initialization and steps are refused (fmi2Error).
+    assert "exitInitializationMode refused, status 3" in done.stdout and "doStep refused, status 3" in done.stdout
+    assert done.stdout.strip().endswith("process still alive")
+
+
 def test_another_number_of_blocks_at_build_time(tmp_path):
     import build_fmus
 

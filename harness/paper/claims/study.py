@@ -4,8 +4,9 @@
 
 A study runs sweeps (through :func:`harness.runs.sweep.run_sweep`, persisted in the
 runner's point store) and single runs or continuation ramps (through
-:func:`harness.runs.sweep.map_with_pool`, each result cached as JSON under
-``<store>/studies`` keyed by its inputs and the FMU's sha256), and returns plain numbers.
+:func:`harness.runs.sweep.cached_map`, each result cached as JSON under
+``<store>/studies`` keyed by its inputs and the FMUs' sha256 as it arrives), and returns
+plain numbers.
 The claim's verdict function turns those numbers into verdicts by explicit criteria.
 
 Sizes (grid points, horizons, ramp steps) come from a :class:`Resolution`; ``default``
@@ -16,10 +17,8 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import hashlib
 import json
 import os
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
@@ -27,9 +26,9 @@ from typing import Callable, Sequence
 import numpy as np
 
 from harness.cosim.fmu import fmu_sha256
-from harness.runs.settings import Integration, PointSettings, RunSettings, canonical_json, default_fmu, to_jsonable
+from harness.runs.settings import Integration, PointSettings, RunSettings, default_fmu
 from harness.runs.store import write_json_atomically
-from harness.runs.sweep import OBSERVABLES_VERSION, Execution, Grid, map_with_pool, run_sweep
+from harness.runs.sweep import Execution, Grid, cached_map, run_sweep
 
 from vibroblock.integrators import INTEGRATOR_RECORDS
 
@@ -236,41 +235,14 @@ class Runner:
 
     def tasks(self, function: Callable, items: Sequence[dict]) -> list[dict]:
         """``function(item, pool)`` for every item, cached by (function, item, FMU hashes)
-        with the seconds it took (``elapsed_s``) beside the result."""
-        folder = self.store / "studies"
-        keys = []
-        for item in items:
-            text = canonical_json({"function": f"{function.__module__}.{function.__qualname__}", "item": item,
-                                   "fmu_sha256": self._sha, "observables_version": OBSERVABLES_VERSION})
-            keys.append(hashlib.sha256(text.encode()).hexdigest())
-        results: dict[int, dict] = {}
-        for number, key in enumerate(keys):
-            path = folder / f"{key}.json"
-            if path.exists():
-                results[number] = json.loads(path.read_text())["result"]
-        missing = [n for n in range(len(items)) if n not in results]
-        self.tasks_computed += len(missing)
-        self.tasks_reused += len(items) - len(missing)
-        if missing:
-            computed = map_with_pool(_Timed(function), [items[n] for n in missing], self.execution, self.client)
-            for number, timed in zip(missing, computed):
-                write_json_atomically(folder / f"{keys[number]}.json", {"item": to_jsonable(items[number]), **timed})
-                results[number] = timed["result"]
-                self.compute_time += timed["elapsed_s"]
-        return [results[n] for n in range(len(items))]
-
-
-@dataclass(frozen=True)
-class _Timed:
-    """``function(item, pool)`` as ``{"result": ..., "elapsed_s": seconds}``, timed where
-    it runs (on a Dask worker, its own time, not the study's wait)."""
-
-    function: Callable
-
-    def __call__(self, item, pool) -> dict:
-        started = time.perf_counter()
-        result = self.function(item, pool)
-        return {"result": result, "elapsed_s": time.perf_counter() - started}
+        in ``<store>/studies`` with the seconds it took (``elapsed_s``) beside the result,
+        each stored as it arrives (:func:`harness.runs.sweep.cached_map`)."""
+        outcome = cached_map(function, items, self.store / "studies", {"fmu_sha256": self._sha}, self.execution,
+                             self.client)
+        self.tasks_computed += outcome.computed
+        self.tasks_reused += outcome.reused
+        self.compute_time += outcome.compute_time
+        return outcome.results
 
 
 def counts(runner: Runner) -> dict:
