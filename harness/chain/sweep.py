@@ -186,8 +186,9 @@ def main(argv=None) -> int:
         dataset = chain_sweep(grid, sweep, args.out, execution)
     except ValueError as exc:
         raise SystemExit(f"python -m harness.chain.sweep: {exc}") from None
-    args.out.mkdir(parents=True, exist_ok=True)
-    dataset.to_netcdf(args.out / "chain_sweep.nc")
+    from harness.runs.dataset_files import save_dataset
+
+    save_dataset(dataset, args.out / "chain_sweep.nc")
     frame = dataset[["events", "system_wide", "b_value", "events_during_record"]].to_dataframe()
     print(frame.to_string())
     print(f"{dataset.attrs['points_computed']} points computed, {dataset.attrs['points_reused']} from the store; "
