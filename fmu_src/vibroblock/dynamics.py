@@ -44,7 +44,7 @@ from .laws import friction_rule as law_friction_rule
 from .laws.plate_vertical import acceleration as plate_acceleration, motion as plate_motion  # noqa: F401
 from .layout import P_GT, P_KD, P_VD
 from .laws import contact_conservative
-from .models import curvature, frame, load, profile  # noqa: F401  (frame: the surface's, for the integrators)
+from .models import curvature, flat_plate, frame, load, profile  # noqa: F401  (frame: the surface's, for the integrators)
 from .readings import free_flight, tangent_frame
 
 
@@ -71,6 +71,10 @@ def surface_contact(kind, x, z, vx, vz, plate_z, plate_v, prm):
     """``contact`` on the surface under the block whatever the flight reading: with
     ``flight = free`` off contact it still returns the surface's frame (u_t, cos a, sin a),
     the frame of a contact phase continued across delta = 0 (the adaptive integrator's)."""
+    if flat_plate(kind):  # the lab's frame (models.flat_plate): no products by cos a = 1, sin a = 0
+        penetration = plate_z - z
+        u_n = vz - plate_v
+        return penetration, u_n, vx, 1.0, 0.0, normal_force(kind, penetration, u_n, prm)
     height, slope = profile(kind, x, prm)
     cos_a, sin_a = frame(slope)
     if tangent_frame(kind):  # state (x, zeta, u, w): the plate moves along the local normal
@@ -124,6 +128,9 @@ def force(kind, x, t, engaged, penetration, normal, u_t, cos_a, sin_a, shear, pr
         stretch = prm[P_KD] * (x - prm[P_VD] * t)
         load_t, load_n = frame_load(kind, cos_a, sin_a, prm)
         return -stretch * cos_a + tangential + load_t, normal + stretch * sin_a + load_n
+    if flat_plate(kind):  # the lab's frame: the normal force along z, the tangential along x
+        load_x, load_z = load(kind, 1.0, 0.0, prm)
+        return -prm[P_KD] * (x - prm[P_VD] * t) + tangential + load_x, normal + load_z
     load_x, load_z = load(kind, cos_a, sin_a, prm)
     fx = -prm[P_KD] * (x - prm[P_VD] * t) - normal * sin_a + tangential * cos_a + load_x
     if engaged:

@@ -136,6 +136,19 @@ def offered_by(models: str) -> list[str]:
 
 
 # ---------------------------------------------------------------- compiled dispatch
+# The variants whose module states ``FLAT = True`` (no slope anywhere), one bit per index.
+_FLAT_MASK = sum(1 << v.kind for v in VARIANTS.values() if getattr(v.module, "FLAT", False))
+
+
+@njit(inline="always")
+def flat_plate(kind):
+    """Whether variant ``kind``'s plate is flat (its module's ``FLAT``).  There the surface's
+    frame is the lab's, and the contact and forces skip the products by cos a = 1 and
+    sin a = 0: they change no value (at an exact zero, only its sign) but cost a tenth of
+    a flat block's step (a folded constant, with the kernels' constant kind)."""
+    return (_FLAT_MASK >> (kind & VARIANT_MASK)) & 1 != 0
+
+
 @njit(inline="always")
 def frame(slope):
     """cos a and sin a of the surface's tangent at a point of the given slope (a = arctan

@@ -4,6 +4,9 @@ from numba import njit
 from ..layout import P_G, P_M
 
 PARAMETERS = ("g",)
+# No slope anywhere: the surface's frame is the lab's (cos a = 1, sin a = 0), and the
+# contact and forces skip the products by them (``models.flat_plate``).
+FLAT = True
 
 
 @njit(inline="always")
