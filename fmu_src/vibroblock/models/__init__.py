@@ -12,6 +12,9 @@ A variant is one module ``model_<name>.py`` stating:
   unit tangent (cos a, sin a) of the surface under it;
 * ``curvature(x, prm)`` (optional; zero, a plane, if absent): the profile's second
   derivative h''(x) (the tangent frame's map to a point, ``vibroblock.readings``; not on any kernel's hot path).
+* ``FLAT = True`` (optional): the profile has no slope anywhere, so the contact and the
+  forces take the lab's frame directly (``flat_plate``), skipping the products by
+  cos a = 1 and sin a = 0 on every step.
 
 Everything else (contact, friction, integrators, the FMU, the docs) is shared and
 reads this registry: adding a variant is adding a module.  The compiled kernels reach a
