@@ -128,7 +128,15 @@ def study_chain(runner: Runner) -> Study:
                                                   events["t_start"]),
                 "triggering": {"t_s": trigger["t_s"], "t_ref": trigger["t_ref"],
                                "shape": triggering_shape(trigger["rows"])}}
-    settings = {"catalogue": {"fmu": CHAIN_FMU, "n_blocks": r.chain_blocks, "horizon": r.chain_horizon,
+    settings = {"models": f"catalogue: {r.chain_blocks} blocks of model A ({CHAIN_FMU}); triggering: the "
+                          "16-block rate-and-state chain (the chain's core)",
+                "parameters": "catalogue: Carlson and Langer's (" + ", ".join(f"{k} {v:g}" for k, v in
+                                                                      CARLSON_LANGER.items()) + "), cluster "
+                              f"catalogue; triggering: periodic loading at {r.chain_acceleration:g} g from phases "
+                              f"{', '.join(f'{p:g}' for p in r.chain_phases)}, periods "
+                              f"{', '.join(f'{p:g}' for p in r.chain_periods)} tau_0",
+                "horizon": r.chain_horizon,
+                "catalogue": {"fmu": CHAIN_FMU, "n_blocks": r.chain_blocks, "horizon": r.chain_horizon,
                               **CARLSON_LANGER, "catalogue": events["thresholds"]},
                 "triggering": {"chain": "harness.chain.triggering.RATE_STATE_STUDY", "acceleration":
                                r.chain_acceleration, "phases": list(r.chain_phases), "periods": list(r.chain_periods)}}
