@@ -182,7 +182,8 @@ def plan(chain, modes: Modes, normals: np.ndarray, n_cap: int):
                       rho2n * turn_n[:, None] * turn_n[None, :])
     cross = _geometric(rho * rho, theta[:, None] - theta[None, :], steps,
                        rho2n * turn_n[:, None] * np.conj(turn_n)[None, :])
-    gram = 0.5 * (np.real(beta[:, None] * beta[None, :] * same) + np.real(beta[:, None] * np.conj(beta)[None, :] * cross))
+    gram = 0.5 * (np.real(beta[:, None] * beta[None, :] * same)
+                  + np.real(beta[:, None] * np.conj(beta)[None, :] * cross))
     squares = np.einsum("ik,ik->i", Q @ gram, Q)
     d_phi = h * (steps * (c - V) ** 2 + squares) + 2.0 * (c - V) * (ring_n - ring_0)
     return steps, x0 + shift, v_n, F0 + shift, d_phi

@@ -45,8 +45,8 @@ from ..integrators.symplectic_euler import euler_step
 from ..laws import plate_moves_sideways
 from ..models import MODELS
 from ..readings import encode
-from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_KT, P_M, P_MUS, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
-                      Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_KT, P_M, P_MUS, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C,
+                      Y_FRICTION_STATE, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..unowned import data_pointer, keep_alive, row_pointer, unowned
 from .clusters import close, follow
 
@@ -344,13 +344,14 @@ def all_stuck(kind, Y, PRM, chn, evt, scratch, plate_z, plate_v):
 
 
 @njit(cache=True)
-def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track_energy, jump_every):
-    """Advance the chain by up to n_steps grid steps.  Returns OK, CATALOGUE_FULL (the
-    steps taken so far are stored: empty ``rows`` and call again), STUCK (``jump_every``
-    > 0: after a step whose number is a multiple of it, every block sticks quietly,
-    ``all_stuck``; the steps so far are stored) or NON_FINITE (the arrays are then
-    partly advanced: the runner restores its copy).  ``jump_every`` = 0: no test, the
-    pass is the plain one."""
+def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, steps, track_energy):
+    """Advance the chain by up to n_steps grid steps, ``steps`` = (n_steps, jump_every).
+    Returns OK, CATALOGUE_FULL (the steps taken so far are stored: empty ``rows`` and call
+    again), STUCK (``jump_every`` > 0: after a step whose number is a multiple of it,
+    every block sticks quietly, ``all_stuck``; the steps so far are stored) or NON_FINITE
+    (the arrays are then partly advanced: the runner restores its copy).  ``jump_every``
+    = 0: no test, the pass is the plain one."""
+    n_steps, jump_every = steps
     drv, cnt, chn = data_pointer(drv), data_pointer(cnt), data_pointer(chn)
     # The per-block arrays through views numba does not count: handed to the step's
     # functions, the counted arrays cost atomic counts at every step (a chain of one

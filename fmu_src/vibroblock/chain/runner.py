@@ -237,8 +237,8 @@ class Chain:
         while self.cnt[L.C_STEP] < target:
             jump_every = J.JUMP_EVERY << self.jump_backoff if jumping else 0
             status = K.advance(self.settings.kind, self.Y, self.PRM, self.cnt, self.drv, self.chn, self.evt,
-                               self.scratch, self.rows, self.clu, int(target - self.cnt[L.C_STEP]),
-                               self.energy_balance, jump_every)
+                               self.scratch, self.rows, self.clu, (int(target - self.cnt[L.C_STEP]), jump_every),
+                               self.energy_balance)
             if status == K.NON_FINITE:
                 self.Y, self.cnt, self.evt, self.scratch, self.clu, self.jumped_steps, self.jump_backoff = kept
                 raise ModelError(f"the chain's state became non-finite between t = {self.time!r} and {t_end!r} "
