@@ -71,13 +71,16 @@ from vibroblock.native import NativeStep
 from vibroblock.parameters import INTEGRATOR_OPTIONS, SCENE_OPTIONS
 
 job = sys.argv[1]
-if job == CHAIN_JOB:  # the chain's kernel, with and without the energy balance
+if job == CHAIN_JOB:  # the chain's kernel, with and without the energy balance, and a jump's probe
     from vibroblock.chain import Chain
     for energy_balance in (False, True):
         chain = Chain(2, energy_balance=energy_balance, A=0.3, omega=0.5)
         chain.start(0.0)
         chain.advance_to(1.0)
         chain.outputs()
+    chain = Chain(2, jump_sticks=True)
+    chain.start(0.0)
+    chain.advance_to(30.0)
     print(json.dumps({"job": job}))
     sys.exit(0)
 options = [{}] + [{name: True} for name in SCENE_OPTIONS] + [
@@ -152,7 +155,8 @@ def entry_files(job_cache: Path) -> list[Path]:
     from vibroblock.integrators import BY_ID
 
     if job_cache.name == CHAIN_JOB:
-        return [path for path in sorted(job_cache.rglob("*.nb?")) if path.name.startswith("kernel.advance-")]
+        return [path for path in sorted(job_cache.rglob("*.nb?"))
+                if path.name.startswith(("kernel.advance-", "kernel.rest_probe-"))]
     record = next(record for record in BY_ID.values() if record.name == job_cache.name)
     # numba names a cache file "<source file's stem>.<qualname>-<line>..." ("__init__" for
     # a kernel defined in a package's __init__.py, e.g. event_driven's).

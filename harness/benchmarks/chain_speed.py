@@ -19,7 +19,14 @@ Measured side by side in one run, compiled kernels warm, CPU seconds, best of ``
    block-step on each side, the speed-up, and the largest difference of the blocks'
    final x (0: the same bits);
 3. BlockChain.fmu through fmpy (16 blocks) at communication steps of 100, 10 and 1 tau_0,
-   reading every output at each: the time per simulated tau_0 against the core's.
+   reading every output at each: the time per simulated tau_0 against the core's;
+4. jumping through sticks (``Chain(jump_sticks=True)``, ``chain.jump``) against stepping,
+   chains of 16, 64, 256 and 1000 blocks at the chain's defaults over the same simulated
+   time, 64 blocks whose ringing decays ten times faster (gamma_t = 0.05), and 256 blocks
+   at Carlson-Langer's parameters with the cluster catalogue: CPU
+   seconds of each, their ratio, the fraction of steps jumped, the events of each, and
+   the largest difference of the final x relative to the largest |x|.  ``--jumps`` runs
+   this section alone (printed, not published).
 
 The ceiling.  A block-step of the default physics needs about 25-30 floating-point
 operations (contact, forces, the update, the friction rule and the phi quadrature); the
@@ -43,12 +50,17 @@ from pathlib import Path
 from vibroblock import Block
 from vibroblock.chain import Chain
 from vibroblock.chain.runner import BLOCK_DEFAULTS
+from vibroblock.layout import C_STEP
 
 from . import ROOT, cpu_info, recorded
 from .build_cost import CORE, SpeedChild, previous_core
 
 SPREAD = {"mu_s_spread": 0.3, "seed": 1}
 SIZES = (1, 16, 64, 256, 1000)
+JUMP_SIZES = (16, 64, 256, 1000)
+# Carlson-Langer's standard parameters in the chain's units (docs/chain.md), cluster catalogue.
+CARLSON_LANGER = {"friction_law": 2, "mu_k": 0.495, "v_w": 0.99, "V_d": 0.05, "gamma_t": 0.2, "mu_s_spread": 0.05,
+                  "seed": 1, "clusters": True}
 TARGET = 1e8  # block-steps per second per core at N = 1000 (the explicit first-order kernel)
 FLOPS_PER_BLOCK_STEP = 27.5  # the physics' own count, 25-30
 FLOPS_PER_CYCLE = 2.0  # scalar double precision: two floating-point ports
@@ -167,6 +179,36 @@ def fmu(fmu_path: Path, t_end: float, core_per_tau: float) -> None:
         print(f"   {step:19g} {wall:8.3f} {wall / t_end / core_per_tau:17.2f}")
 
 
+def _run(n_blocks: int, t_end: float, jump: bool, parameters: dict):
+    chain = Chain(n_blocks, jump_sticks=jump, **parameters)
+    chain.start()
+    chain.advance_to(1.0)  # compiled or loaded outside the timing
+    start = time.process_time()
+    chain.advance_to(t_end)
+    return time.process_time() - start, chain
+
+
+def jumps(t_end: float, carlson_langer_end: float) -> None:
+    """Section 4: the same runs stepped and jumped, one run each."""
+    print(f"\n4. jumping through sticks against stepping, CPU seconds, one run each; |dx|: the largest difference "
+          f"of the final x over the largest |x|")
+    print(f"   {'run':32} {'tau_0':>8} {'stepped s':>10} {'jumped s':>9} {'speed-up':>9} {'jumped':>7} "
+          f"{'events':>13} {'|dx|':>8}")
+    runs = [(f"{n} blocks, defaults", n, t_end, SPREAD) for n in JUMP_SIZES]
+    runs.append(("64 blocks, gamma_t = 0.05", 64, t_end, {**SPREAD, "gamma_t": 0.05}))
+    runs.append(("256 blocks, Carlson-Langer", 256, carlson_langer_end, CARLSON_LANGER))
+    for label, n, end, parameters in runs:
+        seconds_stepped, stepped = _run(n, end, False, parameters)
+        seconds_jumped, jumped = _run(n, end, True, parameters)
+        same = ([e[:4] for e in stepped.events] == [e[:4] for e in jumped.events])
+        scale = max(abs(v) for v in stepped.x)
+        dx = max(abs(a - b) for a, b in zip(stepped.x, jumped.x)) / scale
+        fraction = jumped.jumped_steps / jumped.cnt[C_STEP]
+        events = f"{len(stepped.events)}/{len(jumped.events)}{'' if same else ' (differ)'}"
+        print(f"   {label:32} {end:8g} {seconds_stepped:10.3f} {seconds_jumped:9.3f} "
+              f"{seconds_stepped / seconds_jumped:9.1f} {fraction:7.3f} {events:>13} {dx:8.1e}")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fmu", type=Path, default=ROOT / "build" / "fmus" / "BlockChain.fmu")
@@ -174,8 +216,12 @@ def main(argv=None) -> int:
     parser.add_argument("--previous", default=PREVIOUS,
                         help="the commit whose chain kernel section 2 times ('' to skip)")
     parser.add_argument("--quick", action="store_true", help="short runs, no section 2; publishes nothing")
+    parser.add_argument("--jumps", action="store_true", help="section 4 alone (jumps against steps); publishes nothing")
     args = parser.parse_args(argv)
     t_end = 500.0 if args.quick else 2e4
+    if args.jumps:
+        jumps(t_end, t_end / 2)
+        return 0
     with recorded("chain_speed", argv):
         per_tau = core(t_end, 1 if args.quick else args.rounds)
         if args.previous and not args.quick:
@@ -184,6 +230,7 @@ def main(argv=None) -> int:
             fmu(args.fmu, t_end, per_tau)
         else:
             print(f"\n3. skipped: no {args.fmu} (make fmus)")
+        jumps(t_end, t_end / 2)
     return 0
 
 

@@ -75,6 +75,41 @@ def test_fmu_state_restores_the_run_bit_for_bit(instance, integrator):
     assert first[1][0] > 0
 
 
+def test_jump_sticks_runs_the_cores_jumped_chain_and_restores_bit_for_bit(instance):
+    """Off by default; on, the FMU's outputs are the jumped core's at the same communication
+    points, the run jumps, and a restored state jumps as the run did."""
+    slave, vr = instance
+    assert slave.getBoolean([vr["jump_sticks"]]) == [False]
+    slave.setReal([vr["mu_s_spread"]], [0.3])
+    slave.setBoolean([vr["jump_sticks"]], [True])
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    chain = Chain(16, jump_sticks=True, mu_s_spread=0.3)
+    chain.start()
+    outputs = [vr[f"x[{i}]"] for i in range(1, 17)]
+    for t in (2000.0, 4000.0, 6000.0):
+        slave.doStep(t - 2000.0, 2000.0)
+        chain.advance_to(t)
+    assert slave.getReal(outputs) == chain.x.tolist() and chain.jumped_steps > 0
+    assert slave.getInteger([vr["event_count"]]) == [len(chain.events)]
+    state = slave.serializeFMUstate(slave.getFMUstate())
+    slave.doStep(6000.0, 6000.0)
+    first = slave.getReal(outputs), slave.getInteger([vr["event_count"]])
+    slave.setFMUstate(slave.deSerializeFMUstate(state))
+    slave.doStep(6000.0, 6000.0)
+    assert (slave.getReal(outputs), slave.getInteger([vr["event_count"]])) == first
+
+
+def test_jump_sticks_with_the_energy_balance_gives_fmi2error(instance, fmu_log):
+    slave, vr = instance
+    slave.setBoolean([vr["jump_sticks"], vr["energy_balance"]], [True, True])
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    assert status_of(slave.exitInitializationMode) == fmi2Error
+    assert any("jump_sticks with energy_balance" in record[3] for record in fmu_log.records)
+
+
 def test_bad_settings_and_inputs_give_fmi2error_with_a_message(instance, fmu_log):
     slave, vr = instance
     slave.setReal([vr["v_stop"]], [1.0])  # above v_start = 0.3

@@ -45,8 +45,8 @@ from ..integrators.symplectic_euler import euler_step
 from ..laws import plate_moves_sideways
 from ..models import MODELS
 from ..readings import encode
-from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_M, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C, Y_FRICTION_STATE,
-                      Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
+from ..layout import (C_STEP, D_DT, D_OMEGA, D_T0, P_KT, P_M, P_MUS, Y_DISSIPATED, Y_E_NORMAL, Y_F, Y_PHI, Y_PHI_C,
+                      Y_FRICTION_STATE, Y_VX, Y_VZ, Y_WORK, Y_X, Y_Z)
 from ..unowned import data_pointer, keep_alive, row_pointer, unowned
 from .clusters import close, follow
 
@@ -86,6 +86,7 @@ N_SCRATCH = S_SUM + N_RATES
 R_START, R_END, R_FIRST, R_BLOCKS, R_POTENCY, R_PEAK = range(6)
 N_ROW = 6
 CATALOGUE_FULL = 2  # a status: the steps so far are stored; empty the catalogue and call again
+STUCK = 3  # a status: every block sticks, quiet, with no event open (``jump_every``); the runner may jump
 
 
 @njit(inline="always")
@@ -319,11 +320,38 @@ def cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1):
     return CATALOGUE_FULL if rows.shape[0] - row < clu.shape[0] else OK
 
 
+@njit(inline="always")
+def all_stuck(kind, Y, PRM, chn, evt, scratch, plate_z, plate_v):
+    """Whether every block sticks quietly and the catalogue has nothing open: no chain-wide
+    event (or no block in a cluster), every block's friction law in its stick (state 0),
+    its spring inside the Coulomb bound (|k_t F| < mu_s N, N the contact force on the
+    plate at (``plate_z``, ``plate_v``)) and its slip speed below v_stop.  The cheap test
+    ``advance`` makes every ``jump_every`` steps; the runner's jump (``chain.jump``) checks
+    the rest."""
+    clusters, v_stop = chn[H_CLUSTERS] != 0.0, chn[H_V_STOP]
+    if not clusters and evt[E_OPEN] != 0.0:
+        return False
+    for i in range(Y.shape[0]):
+        if Y[i, Y_FRICTION_STATE] != 0.0 or not abs(Y[i, Y_VX]) < v_stop:
+            return False
+        if clusters and scratch[i, S_LABEL] != 0.0:
+            return False
+        prm = row_pointer(PRM, i)
+        normal = contact(kind, Y[i, Y_X], Y[i, Y_Z], Y[i, Y_VX], Y[i, Y_VZ], plate_z, plate_v, prm)[5]
+        if not abs(prm[P_KT] * Y[i, Y_F]) < prm[P_MUS] * normal:
+            return False
+    return True
+
+
 @njit(cache=True)
-def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track_energy):
-    """Advance the chain by up to n_steps grid steps.  Returns OK, CATALOGUE_FULL (the
-    steps taken so far are stored: empty ``rows`` and call again) or NON_FINITE (the
-    arrays are then partly advanced: the runner restores its copy)."""
+def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, steps, track_energy):
+    """Advance the chain by up to n_steps grid steps, ``steps`` = (n_steps, jump_every).
+    Returns OK, CATALOGUE_FULL (the steps taken so far are stored: empty ``rows`` and call
+    again), STUCK (``jump_every`` > 0: after a step whose number is a multiple of it,
+    every block sticks quietly, ``all_stuck``; the steps so far are stored) or NON_FINITE
+    (the arrays are then partly advanced: the runner restores its copy).  ``jump_every``
+    = 0: no test, the pass is the plain one."""
+    n_steps, jump_every = steps
     drv, cnt, chn = data_pointer(drv), data_pointer(cnt), data_pointer(chn)
     # The per-block arrays through views numba does not count: handed to the step's
     # functions, the counted arrays cost atomic counts at every step (a chain of one
@@ -372,6 +400,9 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, n_steps, track
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         if status != OK:
             break
+        if jump_every > 0 and n % jump_every == 0 and all_stuck(kind, Y, PRM, chn, evt, scratch, pz0, pv0):
+            status = STUCK
+            break
     cnt[C_STEP] = n
     finite = True
     for i in range(Y.shape[0]):
@@ -404,3 +435,25 @@ def lab_offset(kind, drv, cnt):
     phase = phase_after(drv, cnt, n, 0.0)
     position, velocity, _ = plate_sideways(kind, drv, math.sin(phase), math.cos(phase), drv[D_T0] + n * drv[D_DT])
     return position, velocity
+
+
+@njit(cache=True)
+def rest_probe(kind, Y, PRM, cnt, drv, normals):
+    """Each block's Coulomb bound's N over a jump (``chain.jump``), in ``normals``: one
+    trial step of each block from the stored state (a copy: the state is not touched),
+    without coupling, by the pass's own ``step_block``.  A block whose height and vertical
+    velocity that step leaves unchanged, to the bit, in contact, keeps its contact force,
+    which on the flat plate does not depend on x or vx: it is that force.  Any other
+    block gets NaN (its contact still rings, or it is off the plate)."""
+    drv, cnt = data_pointer(drv), data_pointer(cnt)
+    n = cnt[C_STEP]
+    t0, dt = drv[D_T0], drv[D_DT]
+    t, t1 = t0 + n * dt, t0 + (n + 1) * dt
+    s, c = drive_sin_cos(drv, cnt, n)
+    pz, pv = plate_at(drv, s, c, t)
+    for i in range(Y.shape[0]):
+        y, prm = Y[i].copy(), PRM[i]
+        step_block(kind, prm, y, (t, t1, dt), (pz, pv, pz, pv), (0.0, 0.0), 0.0, False)
+        rest = y[Y_Z] == Y[i, Y_Z] and y[Y_VZ] == Y[i, Y_VZ]
+        contact1 = contact(kind, y[Y_X], y[Y_Z], y[Y_VX], y[Y_VZ], pz, pv, prm)
+        normals[i] = coulomb_bound(kind, contact1[5], y[Y_X], t1, prm) if rest and contact1[0] > 0.0 else math.nan

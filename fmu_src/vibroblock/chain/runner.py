@@ -29,6 +29,7 @@ from ..initial_state import place
 from ..laws import friction_law_parameters
 from ..observation import contact_energy, stored_energy
 from ..settings import ModelError, Settings
+from . import jump as J
 from . import kernel as K
 from .catalog import CatalogFile, magnitude
 from .clusters import N_CLU
@@ -89,13 +90,22 @@ class Chain:
 
     def __init__(self, n_blocks: int = 16, *, periodic: bool = False, energy_balance: bool = False,
                  clusters: bool = False, catalog_path: str | Path | None = None,
-                 integrator: str | int = "symplectic_euler", model: str = "A", **parameters):
+                 integrator: str | int = "symplectic_euler", model: str = "A", jump_sticks: bool = False,
+                 **parameters):
         if not (isinstance(n_blocks, (int, np.integer)) and n_blocks >= 1):
             raise ModelError(f"n_blocks = {n_blocks!r}: a chain has at least one block")
         self.n_blocks, self.periodic, self.energy_balance = int(n_blocks), bool(periodic), bool(energy_balance)
         # The catalogue: chain-wide events (an event ends when every block is below v_stop),
         # or clusters of slipping blocks connected in space and time (``chain.clusters``).
         self.clusters = bool(clusters)
+        # Jump through the sticks of the whole chain (``chain.jump``): where the run is in
+        # the jump's domain (``jumps_possible``), else it steps as without.
+        self.jump_sticks = bool(jump_sticks)
+        self.jumped_steps = 0
+        # Tests for a jump come every JUMP_EVERY << jump_backoff steps: each one that finds
+        # no jump doubles the interval (up to JUMP_EVERY << MAX_BACKOFF), a jump resets it.
+        self.jump_backoff = 0
+        self._modes = None
         self.chain_parameters = chain_defaults()
         block = dict(BLOCK_DEFAULTS)
         for name, value in parameters.items():
@@ -161,6 +171,9 @@ class Chain:
             raise ModelError(f"seed = {p['seed']!r} must be a non-negative integer")
         # The coupling is one more spring on each block: the scheme's stability bound
         # (which Settings checks for k_n, k_t, k_d) with the stiffest coupling mode, 4 k_c.
+        if self.jump_sticks and self.energy_balance:
+            raise ModelError("jump_sticks with energy_balance: a jump does not book the work and the dissipation "
+                             "over the stick; turn one of them off")
         m, dt = self.settings.parameters["m"], self.settings.parameters["dt"]
         stiffest = self.settings.parameters["k_t"] + self.settings.parameters["k_d"] + 4.0 * p["k_c"]
         bound = STABLE[self.settings.integrator]
@@ -256,18 +269,60 @@ class Chain:
                              "the end time must be finite and later than the current time")
         t0, dt = self.drv[L.D_T0], self.drv[L.D_DT]
         target = math.floor((t_end - t0) / dt + GRID_TOLERANCE)
-        kept = (self.Y.copy(), self.cnt.copy(), self.evt.copy(), self.scratch.copy(), self.clu.copy())
+        kept = (self.Y.copy(), self.cnt.copy(), self.evt.copy(), self.scratch.copy(), self.clu.copy(),
+                self.jumped_steps, self.jump_backoff)
+        jumping = self.jumps_possible()
         while self.cnt[L.C_STEP] < target:
+            jump_every = J.JUMP_EVERY << self.jump_backoff if jumping else 0
             status = K.advance(self.settings.kind, self.Y, self.PRM, self.cnt, self.drv, self.chn, self.evt,
-                               self.scratch, self.rows, self.clu, int(target - self.cnt[L.C_STEP]),
+                               self.scratch, self.rows, self.clu, (int(target - self.cnt[L.C_STEP]), jump_every),
                                self.energy_balance)
             if status == K.NON_FINITE:
-                self.Y, self.cnt, self.evt, self.scratch, self.clu = kept
+                self.Y, self.cnt, self.evt, self.scratch, self.clu, self.jumped_steps, self.jump_backoff = kept
                 raise ModelError(f"the chain's state became non-finite between t = {self.time!r} and {t_end!r} "
                                  f"(dt = {dt!r}): a smaller dt, or softer springs; the state at t = {self.time!r} "
                                  "is kept")
             self._take_events()
+            if status == K.STUCK:
+                self._jump(int(target - self.cnt[L.C_STEP]))
         self.time = float(t_end)
+
+    # Where a jump can happen: symplectic Euler on model A's flat plate at rest (not on a
+    # corrugated plate, where x moves the contact), the friction laws whose stick is the
+    # plain Cundall-Strack spring (0, 1, 2), every other reading and law at its default.
+    JUMP_LAWS = (0, 1, 2)
+
+    def jumps_possible(self) -> bool:
+        """Whether this run can jump through sticks now (``jump_sticks`` on and the run in
+        the jump's domain: model A, ``symplectic_euler``, friction law 0, 1 or 2 with every other
+        reading and law at model A's default, the plate at rest: no drive amplitude, no
+        plate input moving it).  Outside it the run steps, to the bits of a run without."""
+        if not (self.jump_sticks and self.started and self.settings.integrator == "symplectic_euler"
+                and not self.energy_balance and self.settings.model == "A"):
+            return False
+        readings = self.settings.readings
+        if any(value != 0 for name, value in readings.items() if name != "friction_law"):
+            return False
+        if readings.get("friction_law", 0) not in self.JUMP_LAWS:
+            return False
+        drv = self.drv
+        return drv[L.D_AMP] == 0.0 and drv[L.D_EXT_V] == 0.0 and drv[L.D_EXT_A] == 0.0 and drv[L.D_AMP_X] == 0.0
+
+    def _jump(self, n_cap: int) -> None:
+        """Every block sticks quietly (``kernel.advance`` said STUCK): jump through as much
+        of the stick as is safe (``chain.jump``), or step on where none is (and test less
+        often until a jump is taken)."""
+        if n_cap < J.JUMP_EVERY:
+            return
+        self.jump_backoff = min(self.jump_backoff + 1, J.MAX_BACKOFF)
+        normals = np.empty(self.n_blocks)
+        K.rest_probe(self.settings.kind, self.Y, self.PRM, self.cnt, self.drv, normals)
+        if self._modes is None:
+            self._modes = J.Modes(self.n_blocks, self.periodic)
+        planned = J.plan(self, self._modes, normals, n_cap)
+        if planned is not None and planned[0] >= J.JUMP_EVERY:
+            self.jumped_steps += J.apply(self, planned)
+            self.jump_backoff = 0
 
     def _take_events(self) -> None:
         """Move the events the kernel closed into the catalogue (and its file)."""
@@ -367,7 +422,8 @@ class Chain:
         file is not part of it: it records events as they close)."""
         self._require_started()
         return {"n_blocks": self.n_blocks, "periodic": self.periodic, "energy_balance": self.energy_balance,
-                "clusters": self.clusters,
+                "clusters": self.clusters, "jump_sticks": self.jump_sticks, "jumped_steps": self.jumped_steps,
+                "jump_backoff": self.jump_backoff,
                 "time": self.time, "energy_at_start": self.energy_at_start, "events": list(self.events),
                 "chain_parameters": dict(self.chain_parameters), "settings": self.settings.to_dict(),
                 **{name: getattr(self, name).tolist() for name in ("Y", "PRM", "cnt", "drv", "chn", "evt", "scratch",
@@ -389,6 +445,9 @@ class Chain:
         self.chain_parameters = dict(state["chain_parameters"])
         self.periodic, self.energy_balance = bool(state["periodic"]), bool(state["energy_balance"])
         self.clusters = bool(state["clusters"])
+        self.jump_sticks, self.jumped_steps = bool(state.get("jump_sticks", False)), int(state.get("jumped_steps", 0))
+        self.jump_backoff = int(state.get("jump_backoff", 0))
+        self._modes = None
         for name, value in arrays.items():
             setattr(self, name, value)
         self.rows = self._catalogue_rows()

@@ -100,6 +100,13 @@ class ChainFacade(PlateInputs, FmuFacade):
             description="catalogue events as clusters of slipping blocks connected in space and time (two events at "
                         "two places are two); else chain-wide (an event ends when every block is below v_stop)",
             getter=lambda: self.chain.clusters, setter=lambda value: self._guard(self._set_clusters, bool(value))))
+        self.register_variable(Boolean(
+            "jump_sticks", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description="while every block sticks, jump to shortly before the next failure in closed form instead of "
+                        "stepping through the stick (symplectic_euler, friction_law 0-2, plate at rest; elsewhere "
+                        "the run steps; refused with energy_balance); the same events, the state to rounding",
+            getter=lambda: self.chain.jump_sticks,
+            setter=lambda value: self._guard(self._set_jump_sticks, bool(value))))
         self.register_variable(String(
             "catalog_file", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description=CATALOG_TEXT, getter=lambda: self.catalog_file,
@@ -155,6 +162,10 @@ class ChainFacade(PlateInputs, FmuFacade):
         self._require_not_started("cluster_catalog")
         self.chain.clusters = clusters
 
+    def _set_jump_sticks(self, jump: bool) -> None:
+        self._require_not_started("jump_sticks")
+        self.chain.jump_sticks = jump
+
     def _set_catalog_file(self, path: str) -> None:
         self._require_not_started("catalog_file")
         self.catalog_file = path
@@ -209,6 +220,7 @@ class ChainFacade(PlateInputs, FmuFacade):
                 "parameters": {name: self.chain.parameter(name) for name in self._parameter_names()},
                 "periodic": self.periodic, "energy_balance": self.chain.energy_balance,
                 **{name: self.chain.settings.readings[name] for name in LAWS}, "clusters": self.chain.clusters,
+                "jump_sticks": self.chain.jump_sticks,
                 "integrator": self.chain.settings.integrator,
                 "catalog_file": self.catalog_file}
 
@@ -218,7 +230,7 @@ class ChainFacade(PlateInputs, FmuFacade):
     def _restore(self, state: dict) -> None:
         chain = Chain(self.n_blocks, periodic=bool(state["periodic"]), energy_balance=bool(state["energy_balance"]),
                       **{name: int(state.get(name, 0)) for name in LAWS}, clusters=bool(state["clusters"]),
-                      integrator=str(state["integrator"]),
+                      integrator=str(state["integrator"]), jump_sticks=bool(state.get("jump_sticks", False)),
                       **{name: float(value) for name, value in state["parameters"].items()})
         if state["chain"] is not None:
             chain.set_state(state["chain"])
