@@ -1,7 +1,7 @@
 """Benchmark: what a chain of blocks costs per block and per step, beside the single block
 and beside the chain's previous kernel.
 
-    python -m harness.benchmarks.chain_speed [--quick] [--previous 8b6b5d6]
+    python -m harness.benchmarks.chain_speed [--quick] [--previous e630600]
 
 Measured side by side in one run, compiled kernels warm, CPU seconds, best of ``--rounds``:
 
@@ -12,9 +12,9 @@ Measured side by side in one run, compiled kernels warm, CPU seconds, best of ``
    (1e8 per second per core at N = 1000) and to the ceiling (below), and the ratio of
    the time per block-step to the single block's; then the same with ``rk4`` (the
    chain's fourth-order scheme) beside the single block's ``rk4``;
-2. the chain's kernel against the kernel of commit ``--previous`` (one pass per step for
-   all blocks against one pass per task: coupling, steps, catalogue), each core in its
-   own process (``build_cost.SpeedChild``; the previous core a git worktree in
+2. the chain's kernel against the kernel of commit ``--previous`` (by default the one
+   before a flat plate's contact and forces skipped their products by cos a = 1 and
+   sin a = 0, ``models.flat_plate``), each core in its own process (``build_cost.SpeedChild``; the previous core a git worktree in
    build/work/), measured in turns on the same runs, best of the rounds: ns per
    block-step on each side, the speed-up, and the largest difference of the blocks'
    final x (0: the same bits);
@@ -47,6 +47,7 @@ import os
 import time
 from pathlib import Path
 
+from harness.chain.run import CARLSON_LANGER as CARLSON_LANGER_PARAMETERS
 from vibroblock import Block
 from vibroblock.chain import Chain
 from vibroblock.chain.runner import BLOCK_DEFAULTS
@@ -59,13 +60,13 @@ SPREAD = {"mu_s_spread": 0.3, "seed": 1}
 SIZES = (1, 16, 64, 256, 1000)
 JUMP_SIZES = (16, 64, 256, 1000)
 # Carlson-Langer's standard parameters in the chain's units (docs/chain.md), cluster catalogue.
-CARLSON_LANGER = {"friction_law": 2, "mu_k": 0.495, "v_w": 0.99, "V_d": 0.05, "gamma_t": 0.2, "mu_s_spread": 0.05,
-                  "seed": 1, "clusters": True}
+CARLSON_LANGER = {**CARLSON_LANGER_PARAMETERS, "clusters": True}
 TARGET = 1e8  # block-steps per second per core at N = 1000 (the explicit first-order kernel)
 FLOPS_PER_BLOCK_STEP = 27.5  # the physics' own count, 25-30
 FLOPS_PER_CYCLE = 2.0  # scalar double precision: two floating-point ports
-# The kernel before the single-pass step (coupling, steps and catalogue one pass each).
-PREVIOUS = "8b6b5d6"
+# The kernel before the flat plate's contact and forces skipped the frame's products
+# (``models.flat_plate``); 8b6b5d6 is the one before the single-pass step.
+PREVIOUS = "e630600"
 PREVIOUS_SIZES = (16, 256, 1000)
 
 # Child: the chain's kernel of the core on its path, timed on the runs it is sent; answers
