@@ -75,3 +75,17 @@ def set_real(slave, vr, value) -> int:
 
 def do_step(slave, t, h) -> int:
     return status_of(lambda: slave.fmi2DoStep(slave.component, t, h, 1))
+
+
+def with_another_core(source, other) -> str:
+    """A copy of the FMU at ``source``, written to ``other``, whose bundled vibroblock core
+    differs by one comment: an FMU a process holding the checkout's core must refuse."""
+    import zipfile
+
+    with zipfile.ZipFile(source) as zin, zipfile.ZipFile(other, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            data = zin.read(item)
+            if item.filename == "resources/vibroblock/layout.py":
+                data += b"\n# a different core\n"
+            zout.writestr(item, data)
+    return str(other)

@@ -8,7 +8,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave, fmi2Error
 from fmpy.validation import validate_fmu
 
-from fmu_testing import do_step, fmu_log, status_of  # noqa: F401 (fixture)
+from fmu_testing import do_step, fmu_log, status_of, with_another_core  # noqa: F401 (fixture)
 from harness.chain.catalog import read_catalog
 from harness.chain.run import simulate_chain
 from harness.cosim.masters import run_libcosim
@@ -125,18 +125,12 @@ def test_bad_settings_and_inputs_give_fmi2error_with_a_message(instance, fmu_log
 
 
 OTHER_CORE_SCRIPT = """
-import sys, zipfile
+import sys
 import vibroblock  # the process holds the checkout's core, as the harness's do
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi1 import FMICallException
-source, other, folder = sys.argv[1], sys.argv[2], sys.argv[3]
-with zipfile.ZipFile(source) as zin, zipfile.ZipFile(other, "w", zipfile.ZIP_DEFLATED) as zout:
-    for item in zin.infolist():
-        data = zin.read(item)
-        if item.filename == "resources/vibroblock/layout.py":
-            data += b"\\n# a different core\\n"
-        zout.writestr(item, data)
+other, folder = sys.argv[1], sys.argv[2]
 md = read_model_description(other)
 slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(other, unzipdir=folder),
                   modelIdentifier=md.coSimulation.modelIdentifier, instanceName="other")
@@ -163,8 +157,9 @@ def test_a_chain_fmu_of_another_core_than_the_process_holds_refuses_to_start(cha
     import subprocess
     import sys
 
-    done = subprocess.run([sys.executable, "-c", OTHER_CORE_SCRIPT, chain_fmu, str(tmp_path / "Other.fmu"),
-                           str(tmp_path / "other")], env=dict(os.environ), capture_output=True, text=True, timeout=120)
+    other = with_another_core(chain_fmu, tmp_path / "Other.fmu")
+    done = subprocess.run([sys.executable, "-c", OTHER_CORE_SCRIPT, other, str(tmp_path / "other")],
+                          env=dict(os.environ), capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "different vibroblock core" in done.stdout
     # No call runs the process's core in its place: initialization and steps are refused (fmi2Error).
