@@ -41,7 +41,21 @@ def run_experiment(phases=(0.3, 0.6, 0.9), periods=(1.0, 10.0, 100.0, 1000.0), a
                 rows.append(row)
                 print(f"{phase:6.2f} {period:7g} {acceleration:6.3f} {row['T0']:8.1f} {row['advance']:9.2f} "
                       f"{'yes' if row['triggered'] else 'no'}")
+    print(triggered_fractions(rows))
     return rows
+
+
+def triggered_fractions(rows) -> str:
+    """The fraction of bursts that triggered the event, in all and by acceleration, period and phase."""
+    def share(group):
+        return f"{sum(r['triggered'] for r in group)}/{len(group)}"
+
+    parts = [f"triggered: {share(rows)} bursts"]
+    for key, unit in (("acceleration", " g"), ("period", ""), ("phase", "")):
+        values = sorted({r[key] for r in rows})
+        parts.append(f"by {key}: " + ", ".join(f"{v:g}{unit} {share([r for r in rows if r[key] == v])}"
+                                                for v in values))
+    return "; ".join(parts)
 
 
 CHIRP = {"period_start": 100.0, "period_end": 10.0, "duration": 300.0, "sweep": "log"}

@@ -29,3 +29,14 @@ def test_the_chirp_and_the_record_rows_follow_the_reference_at_zero_amplitude():
                                                                 ("record", 0.2)]
     assert rows[0]["advance"] == 0.0 and rows[1]["advance"] == 0.0
     assert all(0.0 <= r["advance"] <= r["T0"] for r in rows)
+
+
+def test_the_triggered_fractions_count_the_rows():
+    spec = importlib.util.spec_from_file_location("example_chain_triggering_fractions", EXAMPLE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rows = [{"acceleration": a, "period": p, "phase": 0.5, "triggered": t}
+            for a, p, t in ((0.05, 1.0, False), (0.05, 10.0, True), (0.2, 1.0, False), (0.2, 10.0, True))]
+    text = module.triggered_fractions(rows)
+    assert text.startswith("triggered: 2/4 bursts") and "by period: 1 0/2, 10 2/2" in text
+    assert "by acceleration: 0.05 g 1/2, 0.2 g 1/2" in text and "by phase: 0.5 2/4" in text
