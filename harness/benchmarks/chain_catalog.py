@@ -64,9 +64,9 @@ def catalogue(n_blocks: int, horizon: float, integrator: str, dt: float) -> dict
 
 
 def statistics(events: np.ndarray, n_blocks: int, horizon: float) -> dict:
-    from harness.paper.claims.chain import catalogue_statistics
+    from harness.chain.statistics import catalogue_summary
 
-    measured = catalogue_statistics(n_blocks, events[:, 3].astype(int), events[:, 4], events[:, 0])
+    measured = catalogue_summary(n_blocks, events[:, 3].astype(int), events[:, 4], events[:, 0])
     whole = events[events[:, 3] == n_blocks, 4]
     return {"rate": len(events) / horizon * 1e4, "system_wide": measured["system_wide"],
             "b": measured["b_value"].get("b", math.nan), "b_sigma": measured["b_value"].get("sigma", math.nan),

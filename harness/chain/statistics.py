@@ -112,3 +112,42 @@ def _truncated_tau(mean_log: float, log_range: float, start: float) -> float:
         else:
             high = middle
     return 0.5 * (low + high)
+
+
+def magnitudes(potencies) -> np.ndarray:
+    """(2/3) log10 of the positive potencies: the magnitudes of the forward events (a
+    back-slip, potency <= 0, has none)."""
+    p = np.asarray(potencies, dtype=float)
+    return (2.0 / 3.0) * np.log10(p[p > 0])
+
+
+SMALL_QUANTILE = 0.2  # the size exponent's fit starts at this quantile of the small events' potencies
+
+
+def catalogue_summary(n_blocks: int, sizes, potencies, t_start) -> dict:
+    """What a catalogue of a chain of ``n_blocks`` says in numbers: event counts by size,
+    the b-value of the finite magnitudes (by maximum curvature), the size exponent of the
+    forward events smaller than half the chain from their SMALL_QUANTILE up, and the
+    recurrence of system-wide events.  An estimate the catalogue is too small for holds
+    its reason (``{"error": ...}``)."""
+    sizes, potencies, t_start = np.asarray(sizes), np.asarray(potencies, float), np.asarray(t_start, float)
+    whole = sizes == n_blocks
+    small = potencies[(sizes < n_blocks / 2) & (potencies > 0)]
+    measured = {"events": int(sizes.size), "system_wide": int(whole.sum()),
+                "at_least_half": int((sizes >= n_blocks / 2).sum()), "single_block": int((sizes == 1).sum()),
+                "back_slips": int((potencies < 0).sum()), "small_forward": int(small.size)}
+    try:
+        b = b_value(magnitudes(potencies))
+        measured["b_value"] = {"b": b.b, "sigma": b.sigma, "completeness": b.completeness, "n_events": b.n_events}
+    except ValueError as exc:
+        measured["b_value"] = {"error": str(exc)}
+    try:
+        tau = size_exponent(small, float(np.quantile(small, SMALL_QUANTILE)) if small.size else math.inf)
+        measured["size_exponent"] = {"tau": tau.tau, "sigma": tau.sigma, "s_min": tau.s_min, "s_max": tau.s_max,
+                                     "n_events": tau.n_events}
+    except ValueError as exc:
+        measured["size_exponent"] = {"error": str(exc)}
+    intervals = np.diff(np.sort(t_start[whole]))
+    if intervals.size:
+        measured["system_wide_recurrence"] = {"mean": float(intervals.mean()), "std": float(intervals.std())}
+    return measured

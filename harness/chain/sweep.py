@@ -88,7 +88,7 @@ def point_statistics(events, n_blocks: int, stop_time: float, window: tuple[floa
     largest potency, the b-value with its error (NaN with fewer than 2 events above M_c),
     and with a record the events that started while it played and in as long a time
     before it."""
-    from harness.chain.statistics import b_value
+    from harness.chain.statistics import b_value, magnitudes
 
     potency = events.potency.to_numpy(dtype=float)
     measured = {"events": int(len(events)), "events_per_1e4": len(events) / stop_time * 1e4,
@@ -97,7 +97,7 @@ def point_statistics(events, n_blocks: int, stop_time: float, window: tuple[floa
                 "b_value": math.nan, "b_sigma": math.nan,
                 "events_during_record": -1, "events_before_record": -1}
     try:
-        b = b_value((2.0 / 3.0) * np.log10(potency[potency > 0]))
+        b = b_value(magnitudes(potency))
         measured["b_value"], measured["b_sigma"] = b.b, b.sigma
     except ValueError:
         pass

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from harness.chain.statistics import catalogue_summary, magnitudes
 from harness.cosim.fmu import fmu_sha256
 
 from .study import Claim, Runner, Study
@@ -33,7 +34,6 @@ from .study import Claim, Runner, Study
 TEXT: dict = {}
 FIGURES: dict = {}
 CHAIN_FMU = "BlockChain3.fmu"  # N a structural parameter: one FMU for any chain length
-SMALL_QUANTILE = 0.2  # the size exponent's fit starts at this quantile of the small events' potencies
 COMMUNICATION_STEP = 1000.0  # tau_0; the catalogue, written by the FMU, keeps every event between
 
 
@@ -66,36 +66,6 @@ def chain_task(item: dict, pool) -> dict:
     return catalogue_run(item) if item["part"] == "catalogue" else triggering_run(item)
 
 
-def catalogue_statistics(n_blocks: int, sizes, potencies, t_start) -> dict:
-    """What the report states of a catalogue: event counts by size, the b-value of the
-    finite magnitudes, the size exponent of the forward events smaller than the chain and
-    the recurrence of system-wide events."""
-    from harness.chain.statistics import b_value, size_exponent
-
-    sizes, potencies, t_start = np.asarray(sizes), np.asarray(potencies, float), np.asarray(t_start, float)
-    magnitudes = (2.0 / 3.0) * np.log10(potencies[potencies > 0])
-    whole = sizes == n_blocks
-    small = potencies[(sizes < n_blocks / 2) & (potencies > 0)]
-    measured = {"events": int(sizes.size), "system_wide": int(whole.sum()),
-                "at_least_half": int((sizes >= n_blocks / 2).sum()), "single_block": int((sizes == 1).sum()),
-                "back_slips": int((potencies < 0).sum()), "small_forward": int(small.size)}
-    try:
-        b = b_value(magnitudes)
-        measured["b_value"] = {"b": b.b, "sigma": b.sigma, "completeness": b.completeness, "n_events": b.n_events}
-    except ValueError as exc:
-        measured["b_value"] = {"error": str(exc)}
-    try:
-        tau = size_exponent(small, float(np.quantile(small, SMALL_QUANTILE)) if small.size else math.inf)
-        measured["size_exponent"] = {"tau": tau.tau, "sigma": tau.sigma, "s_min": tau.s_min, "s_max": tau.s_max,
-                                     "n_events": tau.n_events}
-    except ValueError as exc:
-        measured["size_exponent"] = {"error": str(exc)}
-    intervals = np.diff(np.sort(t_start[whole]))
-    if intervals.size:
-        measured["system_wide_recurrence"] = {"mean": float(intervals.mean()), "std": float(intervals.std())}
-    return measured
-
-
 def triggering_shape(rows) -> list[dict]:
     """Per phase: the clock advances for periods below T_0 and above it, and their spans
     as fractions of T_0 (the shape Perfettini et al. describe: a small span below, a
@@ -124,8 +94,8 @@ def study_chain(runner: Runner) -> Study:
     triggering = {"part": "triggering", "phases": list(r.chain_phases), "periods": list(r.chain_periods),
                   "acceleration": r.chain_acceleration}
     events, trigger = runner.tasks(chain_task, [catalogue, triggering])
-    measured = {"catalogue": catalogue_statistics(r.chain_blocks, events["n_blocks"], events["potency"],
-                                                  events["t_start"]),
+    measured = {"catalogue": catalogue_summary(r.chain_blocks, events["n_blocks"], events["potency"],
+                                               events["t_start"]),
                 "triggering": {"t_s": trigger["t_s"], "t_ref": trigger["t_ref"],
                                "shape": triggering_shape(trigger["rows"])}}
     settings = {"models": f"catalogue: {r.chain_blocks} blocks of model A ({CHAIN_FMU}); triggering: the "
@@ -177,7 +147,7 @@ def draw(study: Study, save) -> None:
     n, events, measured = study.data["n_blocks"], study.data["events"], study.measured
     sizes, potencies = np.asarray(events["n_blocks"]), np.asarray(events["potency"], float)
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
-    m = np.sort((2.0 / 3.0) * np.log10(potencies[potencies > 0]))
+    m = np.sort(magnitudes(potencies))
     left.semilogy(m, np.arange(m.size, 0, -1), ".", ms=3, label="events with M >= m")
     b = measured["catalogue"]["b_value"]
     if "b" in b:
