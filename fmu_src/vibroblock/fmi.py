@@ -80,6 +80,8 @@ class FmuFacade(Fmi2Slave):
         super().__init__(**kwargs)
         self.start_time = 0.0
         _MADE_ON_THREAD[threading.get_ident()] = weakref.ref(self)
+        # False if this process holds another core than the FMU's: initialization is refused.
+        self._healthy = self._check_core(kwargs.get("resources"))
 
     def _check_core(self, resources) -> bool:
         """The process may already hold a vibroblock import (e.g. the harness): it must be
@@ -149,7 +151,12 @@ class FmuFacade(Fmi2Slave):
         self._changed()
 
     def exit_initialization_mode(self):
-        return self._guard(self._start, self.start_time)
+        return self._guard(self._start_if_healthy, self.start_time)
+
+    def _start_if_healthy(self, start_time: float) -> None:
+        if not self._healthy:
+            raise self.rejected[0]("the FMU cannot be initialized (see the previous error)")
+        self._start(start_time)
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         # The guard written out: a doStep is the call a master makes most, and at a

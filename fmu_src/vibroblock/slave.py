@@ -44,7 +44,6 @@ class BlockFacade(PlateInputs, FmuFacade):
         self.block = Block(self.model, DEFAULT_INTEGRATOR)
         self.plate_input = {name: 0.0 for name in INPUTS}
         self._input_changed = False
-        self._healthy = self._check_core(kwargs.get("resources"))
         self._register_interface()
         # Output name -> value reference: what the front end may also read without Python.
         self._output_refs = {var.name: vr for vr, var in self.vars.items() if var.name in OUTPUTS}
@@ -147,8 +146,6 @@ class BlockFacade(PlateInputs, FmuFacade):
         return self.block.time
 
     def _start(self, start_time: float) -> None:
-        if not self._healthy:
-            raise ModelError("the FMU cannot be initialized (see the previous error)")
         self.block.start(start_time)
         self._apply_input()
 

@@ -58,7 +58,6 @@ class ChainFacade(PlateInputs, FmuFacade):
         self.periodic = False
         self.catalog_file = ""
         self.chain = Chain(self.n_blocks)
-        self._healthy = self._check_core(kwargs.get("resources"))
         self.plate_input = {name: 0.0 for name in INPUTS}
         self._input_changed = False
         self._outputs = None
@@ -199,8 +198,6 @@ class ChainFacade(PlateInputs, FmuFacade):
 
     def _start(self, start_time: float) -> None:
         from .catalog import CatalogFile
-        if not self._healthy:
-            raise ModelError("the FMU cannot be initialized (see the previous error)")
         self.chain.catalog_file = CatalogFile(self.catalog_file) if self.catalog_file else None
         self.chain.start(start_time)
         self._apply_input()
