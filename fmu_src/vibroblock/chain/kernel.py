@@ -321,11 +321,12 @@ def cluster_catalogue(Y, chn, clu, scratch, rows, evt, t, t1):
 
 
 @njit(inline="always")
-def all_stuck(kind, Y, PRM, chn, evt, scratch, plate_z, plate_v):
+def all_stuck(kind, Y, PRM, chn, evt, scratch, t, plate_z, plate_v):
     """Whether every block sticks quietly and the catalogue has nothing open: no chain-wide
     event (or no block in a cluster), every block's friction law in its stick (state 0),
-    its spring inside the Coulomb bound (|k_t F| < mu_s N, N the contact force on the
-    plate at (``plate_z``, ``plate_v``)) and its slip speed below v_stop.  The cheap test
+    its spring inside the Coulomb bound (|k_t F| < mu_s N, N the bound's normal at time t
+    with the plate at (``plate_z``, ``plate_v``), as ``rest_probe`` takes it) and its slip
+    speed below v_stop.  The cheap test
     ``advance`` makes every ``jump_every`` steps; the runner's jump (``chain.jump``) checks
     the rest."""
     clusters, v_stop = chn[H_CLUSTERS] != 0.0, chn[H_V_STOP]
@@ -337,7 +338,8 @@ def all_stuck(kind, Y, PRM, chn, evt, scratch, plate_z, plate_v):
         if clusters and scratch[i, S_LABEL] != 0.0:
             return False
         prm = row_pointer(PRM, i)
-        normal = contact(kind, Y[i, Y_X], Y[i, Y_Z], Y[i, Y_VX], Y[i, Y_VZ], plate_z, plate_v, prm)[5]
+        normal = coulomb_bound(kind, contact(kind, Y[i, Y_X], Y[i, Y_Z], Y[i, Y_VX], Y[i, Y_VZ], plate_z, plate_v,
+                                             prm)[5], Y[i, Y_X], t, prm)
         if not abs(prm[P_KT] * Y[i, Y_F]) < prm[P_MUS] * normal:
             return False
     return True
@@ -400,7 +402,7 @@ def advance(kind, Y, PRM, cnt, drv, chn, evt, scratch, rows, clu, steps, track_e
         n, t, pz0, pv0 = n1, t1, pz1, pv1
         if status != OK:
             break
-        if jump_every > 0 and n % jump_every == 0 and all_stuck(kind, Y, PRM, chn, evt, scratch, pz0, pv0):
+        if jump_every > 0 and n % jump_every == 0 and all_stuck(kind, Y, PRM, chn, evt, scratch, t, pz0, pv0):
             status = STUCK
             break
     cnt[C_STEP] = n

@@ -64,8 +64,7 @@ CHAIN_PARAMETERS = {
 # of those before it as they were).
 SPREADS = (("mu_s_spread", "mu_s"), ("load_spread", "g"), ("rs_a_spread", "rs_a"), ("rs_b_spread", "rs_b"),
            ("rs_D_c_spread", "rs_D_c"))
-# Spreads of a friction law's own parameters: only a law that has them takes them.
-LAW_SPREADS = ("rs_a", "rs_b", "rs_D_c")
+MODEL_SPREADS, LAW_SPREADS = SPREADS[:2], SPREADS[2:]  # of the model's parameters; of a friction law's own
 
 
 # The blocks' defaults where they differ from model A's: the loading of the single block's
@@ -156,11 +155,11 @@ class Chain:
         if not 0.0 <= p["load_spread"] < 1.0:
             raise ModelError(f"load_spread = {p['load_spread']!r} must be in [0, 1): every block keeps a weight")
         model = self.settings.model
-        for spread, name in SPREADS[:2]:
+        for spread, name in MODEL_SPREADS:
             if p[spread] > 0.0 and name not in self.settings.parameters:
                 raise ModelError(f"{spread} = {p[spread]!r} spreads {name}, which model {model} does not have")
         law = friction_law_parameters(self.settings.readings)
-        for spread, name in SPREADS[2:]:
+        for spread, name in LAW_SPREADS:
             if not 0.0 <= p[spread] < 1.0:
                 raise ModelError(f"{spread} = {p[spread]!r} must be in [0, 1): every {name} keeps its sign")
             if p[spread] > 0.0 and name not in law:
@@ -169,11 +168,11 @@ class Chain:
                                  f"has no {name}")
         if p["seed"] != int(p["seed"]) or p["seed"] < 0:
             raise ModelError(f"seed = {p['seed']!r} must be a non-negative integer")
-        # The coupling is one more spring on each block: the scheme's stability bound
-        # (which Settings checks for k_n, k_t, k_d) with the stiffest coupling mode, 4 k_c.
         if self.jump_sticks and self.energy_balance:
             raise ModelError("jump_sticks with energy_balance: a jump does not book the work and the dissipation "
                              "over the stick; turn one of them off")
+        # The coupling is one more spring on each block: the scheme's stability bound
+        # (which Settings checks for k_n, k_t, k_d) with the stiffest coupling mode, 4 k_c.
         m, dt = self.settings.parameters["m"], self.settings.parameters["dt"]
         stiffest = self.settings.parameters["k_t"] + self.settings.parameters["k_d"] + 4.0 * p["k_c"]
         bound = STABLE[self.settings.integrator]
