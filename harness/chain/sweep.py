@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from harness.cosim.fmu import REPO_ROOT, fmu_sha256
-from harness.runs.sweep import INLINE, Execution, Grid, cached_map
+from harness.runs.sweep import Execution, Grid, cached_map
 
 CHAIN_FMU = REPO_ROOT / "build" / "fmus" / "BlockChain3.fmu"
 RECORD_AXIS = "record_scale"
